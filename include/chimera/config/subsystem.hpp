@@ -1,0 +1,76 @@
+#pragma once
+// The subsystem model: plain structs that the YAML loader fills (contract section 1).
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "chimera/module/params.hpp"
+
+namespace chimera {
+
+enum class SchedulerKind { kRm, kDm, kEdf, kMuf };
+enum class Criticality { kHard, kSoft };
+
+std::string_view scheduler_name(SchedulerKind s);
+std::string_view criticality_name(Criticality c);
+
+/// Where something was written: for messages of the form "file:line: key: problem".
+struct SourceLoc {
+  std::string file;
+  int line = 0;  // 1-based; 0 when unknown
+};
+
+struct TaskSpec {
+  std::string name;    // instance name, unique in the file
+  std::string module;  // module type in the registry
+  std::optional<std::int64_t> period_ns;  // absent: aperiodic
+  std::int64_t deadline_ns = 0;           // defaults to the period
+  Criticality criticality = Criticality::kHard;
+  std::optional<std::int64_t> wcet_ns;
+  std::optional<int> cpu;
+  Params params;
+  std::map<std::string, std::string> rename;  // port name -> variable name
+  SourceLoc loc;
+
+  /// The variable that port `port` is bound to after renaming.
+  [[nodiscard]] std::string variable_of(const std::string& port) const {
+    auto it = rename.find(port);
+    return it == rename.end() ? port : it->second;
+  }
+};
+
+struct ConfigurationSpec {
+  std::string name;
+  std::vector<std::string> tasks;
+  SourceLoc loc;
+};
+
+struct SubsystemSpec {
+  std::string name;
+  std::string file;
+  SchedulerKind scheduler = SchedulerKind::kRm;
+  std::vector<int> cpus;  // empty: all
+  std::vector<std::string> plugins;
+  std::vector<std::pair<std::string, std::vector<double>>> constants;  // in file order
+  std::vector<TaskSpec> tasks;
+  std::vector<ConfigurationSpec> configurations;
+  std::string start;  // a configuration name; the loader fills in the first when absent
+
+  [[nodiscard]] const TaskSpec* find_task(std::string_view task_name) const {
+    for (const auto& t : tasks)
+      if (t.name == task_name) return &t;
+    return nullptr;
+  }
+  [[nodiscard]] const ConfigurationSpec* find_configuration(std::string_view config_name) const {
+    for (const auto& c : configurations)
+      if (c.name == config_name) return &c;
+    return nullptr;
+  }
+};
+
+}  // namespace chimera

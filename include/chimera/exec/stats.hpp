@@ -1,0 +1,64 @@
+#pragma once
+// Per-task timing statistics, gathered on the real-time path without allocation: counters and
+// fixed log-scale histograms written by the task's thread and read by anyone.
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+
+namespace chimera {
+
+/// A histogram of nanosecond values with buckets of about 3% width from 1 ns to about 68 s.
+/// One writer (the task's thread), any number of readers. Real-time safe.
+class LatencyHistogram {
+ public:
+  static constexpr int kSubBuckets = 32;  // per power of two: about 3% resolution
+  static constexpr int kPowers = 36;      // 2^36 ns ~ 68 s
+  static constexpr int kBuckets = kSubBuckets * kPowers;
+
+  void record(std::int64_t ns) noexcept;
+  /// The value below which `fraction` of the records fall (bucket upper bound). 0 when empty.
+  [[nodiscard]] std::int64_t percentile(double fraction) const noexcept;
+  [[nodiscard]] std::uint64_t count() const noexcept;
+  [[nodiscard]] std::int64_t max() const noexcept;
+  void reset() noexcept;
+
+  static int bucket_of(std::int64_t ns) noexcept;
+  static std::int64_t upper_bound_of(int bucket) noexcept;
+
+ private:
+  // Single writer: plain load+store with relaxed order is enough; readers only need each value
+  // to be untorn, not ordered with the others.
+  std::array<std::atomic<std::uint64_t>, kBuckets> buckets_{};
+  std::atomic<std::uint64_t> count_{0};
+  std::atomic<std::int64_t> max_{0};
+};
+
+/// A copy of a task's figures, for the timing table and --stats-json.
+struct TaskStatsSnapshot {
+  std::uint64_t cycles = 0;
+  std::uint64_t missed = 0;  // cycles that finished after their deadline
+  std::int64_t exec_mean_ns = 0;
+  std::int64_t exec_max_ns = 0;
+  std::int64_t latency_p50_ns = 0;  // release to start of cycle
+  std::int64_t latency_p99_ns = 0;
+  std::int64_t latency_max_ns = 0;
+};
+
+/// Everything the framework counts for one task. Written only by the task's thread.
+class TaskStats {
+ public:
+  /// One finished cycle. Real-time safe.
+  void record_cycle(std::int64_t latency_ns, std::int64_t exec_ns, bool missed) noexcept;
+  [[nodiscard]] TaskStatsSnapshot snapshot() const noexcept;
+  void reset() noexcept;
+
+ private:
+  LatencyHistogram latency_;
+  std::atomic<std::uint64_t> cycles_{0};
+  std::atomic<std::uint64_t> missed_{0};
+  std::atomic<std::int64_t> exec_sum_ns_{0};
+  std::atomic<std::int64_t> exec_max_ns_{0};
+};
+
+}  // namespace chimera

@@ -1,0 +1,98 @@
+#pragma once
+// A running subsystem: the global table, its tasks, and the executive that releases them on the
+// real clock (one real-time thread per task) or the virtual clock (deterministic, as fast as the
+// machine allows). The shell, the CLI and later the network API all drive it through this API.
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "chimera/config/subsystem.hpp"
+#include "chimera/config/verify.hpp"
+#include "chimera/core/result.hpp"
+#include "chimera/exec/stats.hpp"
+#include "chimera/lifecycle/state.hpp"
+#include "chimera/module/registry.hpp"
+#include "chimera/svt/global_table.hpp"
+
+namespace chimera {
+
+enum class ClockKind { kReal, kVirtual };
+
+struct RunOptions {
+  ClockKind clock = ClockKind::kReal;
+  std::optional<std::string> configuration;  // default: the file's start configuration
+  /// Suffix for the shared memory name, so that tests running in parallel do not collide.
+  std::string shm_suffix;
+  /// Ask for SCHED_FIFO and mlockall (real clock); falls back with one warning if refused.
+  bool realtime_priorities = true;
+};
+
+/// One task as the subsystem interface sees it.
+struct TaskSnapshot {
+  std::string name;
+  std::string module;
+  TaskState state = TaskState::kNotCreated;
+  std::int64_t period_ns = 0;
+  int cpu = -1;  // -1: not pinned
+  TaskStatsSnapshot stats;
+  std::string last_error;  // the last method failure, "" if none
+};
+
+/// Something the subsystem interface should tell the operator (a task entering ERROR, say).
+struct Event {
+  std::int64_t time_ns = 0;
+  std::string task;
+  std::string text;
+};
+
+class Executive;
+
+class Subsystem {
+ public:
+  /// Resolves and verifies the file, creates the global table in shared memory. Refuses an
+  /// illegal start configuration. Not real-time safe.
+  static Result<std::unique_ptr<Subsystem>> create(const SubsystemSpec& spec, const Registry& registry,
+                                                   RunOptions options);
+  ~Subsystem();
+  Subsystem(const Subsystem&) = delete;
+  Subsystem& operator=(const Subsystem&) = delete;
+
+  /// Spawns then turns on every task of the start configuration. If any init fails, everything
+  /// spawned so far is killed and the error returned: never a partial start.
+  Result<void> start();
+  /// Sends a lifecycle signal to one task and waits until its thread has carried it out.
+  Result<void> signal(std::string_view task, Signal signal);
+  /// Lets the subsystem run for `ns`: simulated time on the virtual clock, a sleep on the real one.
+  void run_for(std::int64_t ns);
+  /// Off, then kill, every task; removes the shared memory. Idempotent.
+  void stop();
+
+  /// Time since start on the subsystem's clock.
+  [[nodiscard]] std::int64_t now_ns() const;
+  [[nodiscard]] ClockKind clock() const;
+  [[nodiscard]] const SubsystemSpec& spec() const;
+  [[nodiscard]] const ResolvedSubsystem& resolved() const;
+  [[nodiscard]] GlobalTable& table();
+
+  /// The current value of a variable, converted to doubles; and a write by the operator,
+  /// refused if an ON task produces the variable.
+  Result<std::vector<double>> get(std::string_view variable) const;
+  Result<void> set(std::string_view variable, const std::vector<double>& values);
+
+  [[nodiscard]] std::vector<TaskSnapshot> snapshot() const;
+  /// Events since the last call (drained from the tasks' real-time rings).
+  std::vector<Event> drain_events();
+  /// Whether any hard task ended up in ERROR during the run.
+  [[nodiscard]] bool hard_task_failed() const;
+
+ private:
+  Subsystem();
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace chimera

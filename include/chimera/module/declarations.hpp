@@ -1,0 +1,85 @@
+#pragma once
+// What a module declares about itself: its ports (with sizes that may depend on an in-const such
+// as ndof) and its parameters. The framework allocates and binds; the module never does.
+
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "chimera/module/params.hpp"
+#include "chimera/svt/elem_type.hpp"
+#include "chimera/svt/port_kind.hpp"
+
+namespace chimera {
+
+/// An element count: `factor` alone, or `factor` times the value of the in-const `symbol`
+/// (its first element), e.g. Dim::of("ndof", 6) for a 6 x ndof Jacobian.
+struct Dim {
+  std::uint32_t factor = 1;
+  std::string symbol;  // empty: a fixed count
+
+  static Dim fixed(std::uint32_t n) { return Dim{n, {}}; }
+  static Dim of(std::string symbol, std::uint32_t factor = 1) { return Dim{factor, std::move(symbol)}; }
+};
+
+/// "6", "ndof", "6*ndof".
+std::string to_string(const Dim& d);
+
+struct PortDecl {
+  std::string name;
+  PortKind kind;
+  ElemType type;
+  Dim dim;
+  std::vector<double> value;  // out-consts: the value the module will publish, known up front
+  std::string doc;
+};
+
+struct ParamDecl {
+  std::string name;
+  ParamType type;
+  ParamValue default_value;
+  std::string unit;  // "rad", "N*m/rad", "" for none
+  std::string doc;
+};
+
+/// Filled by a module's static declare(Declarations&, const Params&).
+class Declarations {
+ public:
+  template <class T = double>
+  void in_const(std::string name, Dim dim, std::string doc) {
+    ports_.push_back({std::move(name), PortKind::kInConst, kElemTypeOf<T>, std::move(dim), {}, std::move(doc)});
+  }
+  template <class T = double>
+  void in_var(std::string name, Dim dim, std::string doc) {
+    ports_.push_back({std::move(name), PortKind::kInVar, kElemTypeOf<T>, std::move(dim), {}, std::move(doc)});
+  }
+  template <class T = double>
+  void out_var(std::string name, Dim dim, std::string doc) {
+    ports_.push_back({std::move(name), PortKind::kOutVar, kElemTypeOf<T>, std::move(dim), {}, std::move(doc)});
+  }
+  /// Out-consts are f64 and their value is known when the module is declared (from its
+  /// parameters), so that verification can size other tasks' ports before anything runs.
+  void out_const(std::string name, std::vector<double> value, std::string doc) {
+    const auto n = static_cast<std::uint32_t>(value.size());
+    ports_.push_back({std::move(name), PortKind::kOutConst, ElemType::kF64, Dim::fixed(n), std::move(value),
+                      std::move(doc)});
+  }
+  void param(std::string name, ParamValue default_value, std::string unit, std::string doc) {
+    const ParamType type = param_type_of(default_value);
+    params_.push_back({std::move(name), type, std::move(default_value), std::move(unit), std::move(doc)});
+  }
+  /// What the module's resource port talks to (hardware, a simulation, a socket), for docs.
+  void resource(std::string what) { resource_ = std::move(what); }
+
+  [[nodiscard]] const std::vector<PortDecl>& ports() const { return ports_; }
+  [[nodiscard]] const std::vector<ParamDecl>& params() const { return params_; }
+  [[nodiscard]] const std::string& resource() const { return resource_; }
+
+ private:
+  std::vector<PortDecl> ports_;
+  std::vector<ParamDecl> params_;
+  std::string resource_;
+};
+
+}  // namespace chimera

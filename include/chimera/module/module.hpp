@@ -1,0 +1,146 @@
+#pragma once
+// The port-based object (paper 3.3, Figure 7): what a module author writes.
+//
+//   class Pid final : public chimera::Module {
+//    public:
+//     static constexpr const char* kName = "pid_joint";
+//     static constexpr const char* kSummary = "PID joint position controller";
+//     static constexpr const char* kDoc = "tau = Kp e + Ki int(e) + Kd de/dt ...";
+//     static void declare(chimera::Declarations& d, const chimera::Params&) {
+//       d.in_const("ndof", chimera::Dim::fixed(1), "degrees of freedom");
+//       d.in_var("theta_d", chimera::Dim::of("ndof"), "desired joint positions, rad");
+//       d.out_var("tau_r", chimera::Dim::of("ndof"), "reference torques, N*m");
+//       d.param("kp", 100.0, "N*m/rad", "proportional gain");
+//     }
+//    protected:
+//     chimera::Status init(chimera::InitContext& ctx) override {
+//       theta_d_ = ctx.in<double>("theta_d");   // resolved once, by port name
+//       tau_r_ = ctx.out<double>("tau_r");
+//       kp_ = ctx.params().number("kp");
+//       return chimera::Status::ok();
+//     }
+//     chimera::Status cycle() override { ... touches only theta_d_, tau_r_ ... }
+//    private:
+//     chimera::In<double> theta_d_; chimera::Out<double> tau_r_; double kp_ = 0;
+//   };
+//   CHIMERA_REGISTER_MODULE(Pid);
+//
+// The framework calls the methods (never the module itself), transfers the state variables
+// before and after each, times them, and turns a failure or an exception into the lifecycle's
+// error path. init, reinit and kill may allocate; on, cycle, off, error, clear and sync run on
+// the task's real-time thread and should not.
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+#include "chimera/core/result.hpp"
+#include "chimera/module/declarations.hpp"
+#include "chimera/module/params.hpp"
+#include "chimera/svt/local_table.hpp"
+#include "chimera/svt/view.hpp"
+
+namespace chimera {
+
+/// Timing of the current cycle, kept up to date by the framework; modules read it through the
+/// reference InitContext::timing() hands out. Times come from the subsystem's clock (real or
+/// virtual), so modules that use them stay deterministic on the virtual clock.
+struct CycleTiming {
+  std::int64_t release_ns = 0;     // nominal release of the current cycle, since subsystem start
+  std::int64_t period_ns = 0;      // 0 for an aperiodic task
+  std::uint64_t cycle = 0;         // cycles completed before this one
+};
+
+/// Read-only facts about the running subsystem that any module may look at.
+class SubsystemFlags {
+ public:
+  virtual ~SubsystemFlags() = default;
+  /// The paper's illegal-configuration flag (section 3.4). Real-time safe.
+  [[nodiscard]] virtual bool illegal_configuration() const noexcept = 0;
+};
+
+/// What a module receives in init(): its parameters, its typed port views, its timing.
+class InitContext {
+ public:
+  InitContext(std::string_view task_name, const Params& params, LocalTable& local, const CycleTiming& timing,
+              const SubsystemFlags& flags)
+      : task_name_(task_name), params_(params), local_(local), timing_(timing), flags_(flags) {}
+
+  /// A view onto input port `port` (in-var or in-const). A wrong name, kind or element type
+  /// returns an unbound view and makes init fail with a message naming the port.
+  template <class T>
+  In<T> in(std::string_view port) {
+    auto r = local_.input<T>(port);
+    if (r) return *r;
+    note_failure(r.error().message);
+    return {};
+  }
+  /// A view onto output port `port` (out-var or out-const); same failure rule as in().
+  template <class T>
+  Out<T> out(std::string_view port) {
+    auto r = local_.output<T>(port);
+    if (r) return *r;
+    note_failure(r.error().message);
+    return {};
+  }
+
+  [[nodiscard]] const Params& params() const { return params_; }
+  [[nodiscard]] std::string_view task_name() const { return task_name_; }
+  [[nodiscard]] const CycleTiming& timing() const { return timing_; }
+  [[nodiscard]] const SubsystemFlags& flags() const { return flags_; }
+  /// Period in seconds (0 for aperiodic tasks).
+  [[nodiscard]] double period_s() const { return static_cast<double>(timing_.period_ns) * 1e-9; }
+
+  [[nodiscard]] bool failed() const { return !binding_error_.empty(); }
+  [[nodiscard]] const std::string& binding_error() const { return binding_error_; }
+
+ private:
+  void note_failure(const std::string& message) {
+    if (binding_error_.empty()) binding_error_ = message;
+  }
+
+  std::string_view task_name_;
+  const Params& params_;
+  LocalTable& local_;
+  const CycleTiming& timing_;
+  const SubsystemFlags& flags_;
+  std::string binding_error_;
+};
+
+class Task;
+
+/// Base class of every module. Override only the methods you need; the defaults succeed,
+/// except error(), whose default reports that the fault was not recovered.
+class Module {
+ public:
+  Module() = default;
+  Module(const Module&) = delete;
+  Module& operator=(const Module&) = delete;
+  virtual ~Module() = default;
+
+ protected:
+  /// Create: bind ports, allocate, open resources. An error here calls kill().
+  virtual Status init(InitContext& /*ctx*/) { return Status::ok(); }
+  /// Activate: bring internal state up to the subsystem's current state.
+  virtual Status on() { return Status::ok(); }
+  /// One period (or one event of an aperiodic task).
+  virtual Status cycle() { return Status::ok(); }
+  /// Deactivate; leave the subsystem in a safe state.
+  virtual Status off() { return Status::ok(); }
+  /// Destroy: free what init took.
+  virtual Status kill() { return Status::ok(); }
+  /// Called after any other method failed; ok() means the fault was handled and the task goes
+  /// on, a failure sends it to ERROR until an operator's clear.
+  virtual Status error() { return Status::fail("module has no error handler"); }
+  /// The operator says the fault is fixed; ok() only if it really is (the task returns to OFF).
+  virtual Status clear() { return Status::ok(); }
+  /// An in-const changed (another producer of it joined); the new values are in the views.
+  virtual Status reinit() { return Status::ok(); }
+  /// Aperiodic tasks: wait for the next event on the resource port.
+  virtual Status sync() { return Status::ok(); }
+
+ private:
+  friend class Task;  // the framework's non-virtual interface calls the hooks above
+};
+
+}  // namespace chimera

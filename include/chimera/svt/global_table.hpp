@@ -1,0 +1,82 @@
+#pragma once
+// The global state variable table (paper 3.1, Figure 5): one region of POSIX shared memory,
+// laid out with offsets only, holding the most recent value of every variable of the subsystem.
+// Protocol (docs/state-variables.md): one writer per variable, several slots per variable, a
+// sequence number per slot; readers never see a torn value and never wait for a writer, even
+// one preempted mid-write.
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "chimera/core/result.hpp"
+#include "chimera/svt/elem_type.hpp"
+#include "chimera/svt/freshness.hpp"
+
+namespace chimera {
+
+/// Index of a variable in the global table; resolved once, used on the real-time path.
+using VarIndex = std::uint32_t;
+
+/// What a read brought back.
+struct ReadOutcome {
+  Freshness freshness;    // kNoData: never written; kOld: nothing newer than `seen`; kNew: copied
+  std::uint64_t version;  // version now held by the reader's copy (pass it back as `seen`)
+};
+
+class GlobalTable {
+ public:
+  /// Creates the region /chimera_<name> (mode 0600) and lays out `vars`. The returned owner
+  /// unlinks the region when destroyed. A stale region left by a dead process of the same
+  /// name is replaced. Not real-time safe.
+  static Result<GlobalTable> create(std::string_view subsystem_name, std::span<const VarSpec> vars);
+  /// Maps an existing region read-write, e.g. from another process. Not real-time safe.
+  static Result<GlobalTable> attach(std::string_view subsystem_name);
+
+  GlobalTable(GlobalTable&& other) noexcept;
+  GlobalTable& operator=(GlobalTable&& other) noexcept;
+  GlobalTable(const GlobalTable&) = delete;
+  GlobalTable& operator=(const GlobalTable&) = delete;
+  ~GlobalTable();
+
+  /// Name of the shared memory object, e.g. "/chimera_fig4".
+  [[nodiscard]] const std::string& shm_name() const { return shm_name_; }
+  [[nodiscard]] std::size_t size() const noexcept;
+  [[nodiscard]] std::optional<VarIndex> find(std::string_view name) const;
+  [[nodiscard]] std::string_view name(VarIndex v) const noexcept;
+  [[nodiscard]] VarShape shape(VarIndex v) const noexcept;
+
+  /// Publishes shape(v).bytes() bytes from `src` as the newest value. Only one thread may write a
+  /// given variable (rule 1). Real-time safe, wait-free.
+  void write(VarIndex v, const void* src) noexcept;
+  /// Copies the newest complete value into `dst` if it is newer than `seen` (a version returned
+  /// by an earlier read, 0 at first). Never torn, never waits for a writer; if a writer laps the
+  /// reader on every bounded retry, reports kOld and leaves `dst` as it was. Real-time safe.
+  ReadOutcome read(VarIndex v, void* dst, std::uint64_t seen) const noexcept;
+  /// Completed writes of v so far (0: never written). Real-time safe.
+  [[nodiscard]] std::uint64_t version(VarIndex v) const noexcept;
+
+  /// The global illegal-configuration flag (paper 3.4). Real-time safe.
+  void set_illegal_configuration(bool raised) noexcept;
+  [[nodiscard]] bool illegal_configuration() const noexcept;
+
+  /// A write split in two, so that tests can stop a writer in the middle of one. `write()` is
+  /// begin_write + store_words over all words + end_write.
+  void begin_write(VarIndex v) noexcept;
+  void store_bytes(VarIndex v, std::size_t byte_offset, const void* src, std::size_t bytes) noexcept;
+  void end_write(VarIndex v) noexcept;
+
+ private:
+  GlobalTable() = default;
+  void release() noexcept;
+
+  std::string shm_name_;
+  std::byte* base_ = nullptr;  // start of the mapping; everything inside is found by offset
+  std::size_t mapped_bytes_ = 0;
+  bool owner_ = false;
+};
+
+}  // namespace chimera

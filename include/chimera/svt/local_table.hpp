@@ -1,0 +1,74 @@
+#pragma once
+// A task's local state variable table (paper 3.1): private copies of only the variables the task
+// uses, and the transfers between them and the global table.
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "chimera/core/result.hpp"
+#include "chimera/svt/elem_type.hpp"
+#include "chimera/svt/freshness.hpp"
+#include "chimera/svt/global_table.hpp"
+#include "chimera/svt/port_kind.hpp"
+#include "chimera/svt/view.hpp"
+
+namespace chimera {
+
+/// One port of a task bound to a variable of the global table (after renaming).
+struct PortBinding {
+  std::string port;      // the module's port name
+  std::string variable;  // the global variable it is bound to
+  PortKind kind;
+  VarShape shape;
+};
+
+class LocalTable {
+ public:
+  /// Allocates local storage for `ports` and resolves each variable in `global` once.
+  /// Not real-time safe.
+  static Result<LocalTable> create(GlobalTable& global, std::span<const PortBinding> ports);
+
+  /// A typed view onto port `port`; fails if the port does not exist, has another kind
+  /// (input vs output), or T is not its element type. Used in init. Not real-time safe.
+  template <class T>
+  Result<In<T>> input(std::string_view port);
+  template <class T>
+  Result<Out<T>> output(std::string_view port);
+
+  // Transfers (real-time safe): global -> local for inputs, local -> global for outputs.
+  void pull_in_consts() noexcept;
+  void pull_in_vars() noexcept;
+  void push_out_vars() noexcept;
+  void push_out_consts() noexcept;
+
+  /// Zeros every local copy and marks inputs kNoData: a task joining a configuration starts
+  /// fresh. Real-time safe.
+  void reset() noexcept;
+
+  [[nodiscard]] std::span<const PortBinding> ports() const noexcept { return ports_; }
+
+ private:
+  struct Slot {
+    VarIndex var;
+    PortKind kind;
+    std::uint32_t offset;  // into storage_
+    std::uint32_t bytes;
+    std::uint64_t seen;    // version of the global value held locally
+  };
+  LocalTable() = default;
+  Result<const Slot*> find_slot(std::string_view port, bool want_input, ElemType type) const;
+
+  GlobalTable* global_ = nullptr;
+  std::vector<PortBinding> ports_;
+  std::vector<Slot> slots_;  // parallel to ports_
+  std::vector<Freshness> freshness_;  // parallel to ports_
+  std::vector<std::max_align_t> storage_;  // aligned for any element type
+};
+
+}  // namespace chimera
+
+#include "chimera/svt/detail/local_table.inl"
