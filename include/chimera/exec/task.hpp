@@ -1,0 +1,101 @@
+#pragma once
+// A task: one port-based object instance with its local state variable table and lifecycle.
+// The framework's non-virtual interface: every module method is called from here, wrapped in
+// the state variable transfers, timed, and guarded so that a failure or an exception becomes
+// the lifecycle's error path instead of escaping (paper 3.3, Figure 7).
+//
+// A task's methods are called by one thread at a time: its own thread on the real clock, the
+// simulation thread on the virtual clock. state() and stats() may be read from anywhere.
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "chimera/config/verify.hpp"
+#include "chimera/core/result.hpp"
+#include "chimera/exec/event_ring.hpp"
+#include "chimera/exec/stats.hpp"
+#include "chimera/lifecycle/state.hpp"
+#include "chimera/module/module.hpp"
+#include "chimera/svt/global_table.hpp"
+#include "chimera/svt/local_table.hpp"
+
+namespace chimera {
+
+class Task {
+ public:
+  static constexpr std::size_t kEventCapacity = 64;
+
+  Task(const ResolvedTask& resolved, GlobalTable& table, const SubsystemFlags& flags);
+  ~Task();
+  Task(const Task&) = delete;
+  Task& operator=(const Task&) = delete;
+
+  [[nodiscard]] const std::string& name() const { return spec_.name; }
+  [[nodiscard]] const TaskSpec& spec() const { return spec_; }
+  [[nodiscard]] const ResolvedTask& resolved() const { return resolved_; }
+  [[nodiscard]] bool periodic() const { return spec_.period_ns.has_value(); }
+  [[nodiscard]] std::int64_t period_ns() const { return spec_.period_ns.value_or(0); }
+  [[nodiscard]] bool hard() const { return spec_.criticality == Criticality::kHard; }
+
+  /// Current lifecycle state. Real-time safe, any thread.
+  [[nodiscard]] TaskState state() const noexcept { return state_.load(std::memory_order_acquire); }
+
+  /// Carries out a lifecycle signal: spawn calls init (allocation allowed), on calls on, off
+  /// calls off, kill calls off if ON then kill, clear calls clear. `now_ns` stamps events.
+  /// A signal the current state does not allow is refused and changes nothing.
+  Result<void> apply(Signal signal, std::int64_t now_ns);
+
+  /// One cycle released at `release_ns` and started at `start_ns` (subsystem clock): in-vars
+  /// in, cycle(), out-vars out, statistics, and the error path if cycle() fails. Does nothing
+  /// unless ON. On the virtual clock a cycle takes no simulated time. Real-time safe for the
+  /// framework's part.
+  void run_cycle(std::int64_t release_ns, std::int64_t start_ns, std::int64_t deadline_ns,
+                 bool clock_is_virtual) noexcept;
+
+  [[nodiscard]] const TaskStats& stats() const { return stats_; }
+  [[nodiscard]] EventRing<kEventCapacity>& events() { return events_; }
+  /// Whether this task has entered ERROR at least once. Any thread.
+  [[nodiscard]] bool ever_in_error() const noexcept { return ever_in_error_.load(std::memory_order_relaxed); }
+  /// Timing seen by the module through InitContext::timing().
+  [[nodiscard]] const CycleTiming& timing() const { return timing_; }
+
+ private:
+  enum class Hook : std::uint8_t { kOn, kCycle, kOff, kKill, kError, kClear, kReinit, kSync };
+
+  Result<void> spawn(std::int64_t now_ns);
+  Result<void> turn_on(std::int64_t now_ns);
+  Result<void> turn_off(std::int64_t now_ns);
+  Result<void> kill(std::int64_t now_ns);
+  Result<void> clear(std::int64_t now_ns);
+
+  /// Calls a hook with in-vars pulled before and out-vars pushed after; an exception becomes a
+  /// failed Status whose reason lives in exception_text_. Real-time safe for the framework.
+  Status call(Hook hook) noexcept;
+  Status call_raw(Hook hook) noexcept;
+  /// The paper's error rule after `hook` failed with `failure`: error() may recover (true);
+  /// otherwise the task enters ERROR (false). Real-time safe.
+  bool recover(Hook hook, Status failure, std::int64_t now_ns) noexcept;
+  void set_state(TaskState s) noexcept;
+  void destroy_module() noexcept;
+
+  TaskSpec spec_;
+  ResolvedTask resolved_;
+  GlobalTable& table_;
+  const SubsystemFlags& flags_;
+
+  std::unique_ptr<Module> module_;
+  std::unique_ptr<LocalTable> local_;
+  CycleTiming timing_;
+  TaskStats stats_;
+  EventRing<kEventCapacity> events_;
+  std::array<char, 160> exception_text_{};
+
+  alignas(64) std::atomic<TaskState> state_{TaskState::kNotCreated};
+  std::atomic<bool> ever_in_error_{false};
+};
+
+}  // namespace chimera

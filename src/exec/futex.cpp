@@ -1,0 +1,33 @@
+#include "futex.hpp"
+
+#include <linux/futex.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <climits>
+
+#include "chimera/exec/clock.hpp"
+
+namespace chimera::detail {
+
+namespace {
+long futex(const std::atomic<std::uint32_t>& word, int op, std::uint32_t value, const timespec* timeout) noexcept {
+  // The kernel reads the word itself; the cast drops const because the syscall's type demands it.
+  auto* addr = const_cast<std::uint32_t*>(reinterpret_cast<const std::uint32_t*>(&word));  // NOLINT: syscall ABI
+  return syscall(SYS_futex, addr, op, value, timeout, nullptr, FUTEX_BITSET_MATCH_ANY);
+}
+}  // namespace
+
+bool futex_wait(const std::atomic<std::uint32_t>& word, std::uint32_t expected, std::int64_t deadline_ns) noexcept {
+  // FUTEX_WAIT_BITSET takes an absolute CLOCK_MONOTONIC time, so no drift from relative waits.
+  const timespec ts = to_timespec(deadline_ns < 0 ? 0 : deadline_ns);
+  const long r = futex(word, FUTEX_WAIT_BITSET | FUTEX_PRIVATE_FLAG, expected, deadline_ns < 0 ? nullptr : &ts);
+  return !(r == -1 && errno == ETIMEDOUT);
+}
+
+void futex_wake_all(const std::atomic<std::uint32_t>& word) noexcept {
+  (void)futex(word, FUTEX_WAKE_BITSET | FUTEX_PRIVATE_FLAG, INT_MAX, nullptr);
+}
+
+}  // namespace chimera::detail

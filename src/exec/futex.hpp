@@ -1,0 +1,18 @@
+#pragma once
+// Sleeping on a 32-bit atomic word (Linux futex). Synchronisation itself is done with the
+// atomics' memory orders; the futex only puts a thread to sleep and wakes it.
+
+#include <atomic>
+#include <cstdint>
+
+namespace chimera::detail {
+
+static_assert(sizeof(std::atomic<std::uint32_t>) == sizeof(std::uint32_t), "futex needs a plain 32-bit word");
+
+/// Sleeps while `word` holds `expected`, until woken or until the absolute CLOCK_MONOTONIC time
+/// `deadline_ns` (< 0: no deadline). Returns false on timeout. Spurious returns are possible.
+bool futex_wait(const std::atomic<std::uint32_t>& word, std::uint32_t expected, std::int64_t deadline_ns) noexcept;
+/// Wakes every thread sleeping on `word`.
+void futex_wake_all(const std::atomic<std::uint32_t>& word) noexcept;
+
+}  // namespace chimera::detail

@@ -1,0 +1,87 @@
+#include "chimera/exec/stats.hpp"
+
+#include <algorithm>
+#include <bit>
+
+namespace chimera {
+
+// Buckets: values below kSubBuckets have one bucket each; above, each power of two is split
+// into kSubBuckets equal parts (about 3% wide). Bucket math is shifts only: real-time safe.
+int LatencyHistogram::bucket_of(std::int64_t ns) noexcept {
+  if (ns < kSubBuckets) return ns < 0 ? 0 : static_cast<int>(ns);
+  const auto v = static_cast<std::uint64_t>(ns);
+  const int power = std::bit_width(v) - 1;   // v in [2^power, 2^(power+1))
+  const int shift = power - 5;               // 5 = log2(kSubBuckets)
+  const int sub = static_cast<int>((v >> shift) - kSubBuckets);
+  const int bucket = (shift + 1) * kSubBuckets + sub;
+  return std::min(bucket, kBuckets - 1);
+}
+
+std::int64_t LatencyHistogram::upper_bound_of(int bucket) noexcept {
+  if (bucket < kSubBuckets) return bucket;
+  const int shift = bucket / kSubBuckets - 1;
+  const int sub = bucket % kSubBuckets;
+  return (static_cast<std::int64_t>(kSubBuckets + sub + 1) << shift) - 1;
+}
+
+void LatencyHistogram::record(std::int64_t ns) noexcept {
+  auto& b = buckets_[static_cast<std::size_t>(bucket_of(ns))];
+  // Single writer: load+store instead of a locked read-modify-write; relaxed because readers
+  // need each counter untorn, not ordered against the others.
+  b.store(b.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+  count_.store(count_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+  if (ns > max_.load(std::memory_order_relaxed)) max_.store(ns, std::memory_order_relaxed);
+}
+
+std::int64_t LatencyHistogram::percentile(double fraction) const noexcept {
+  const std::uint64_t total = count_.load(std::memory_order_relaxed);  // a snapshot; may lag
+  if (total == 0) return 0;
+  const auto rank = static_cast<std::uint64_t>(fraction * static_cast<double>(total - 1)) + 1;
+  std::uint64_t seen = 0;
+  for (int i = 0; i < kBuckets; ++i) {
+    seen += buckets_[static_cast<std::size_t>(i)].load(std::memory_order_relaxed);  // untorn is enough
+    if (seen >= rank) return std::min(upper_bound_of(i), max());
+  }
+  return max();
+}
+
+std::uint64_t LatencyHistogram::count() const noexcept { return count_.load(std::memory_order_relaxed); }
+std::int64_t LatencyHistogram::max() const noexcept { return max_.load(std::memory_order_relaxed); }
+
+void LatencyHistogram::reset() noexcept {
+  for (auto& b : buckets_) b.store(0, std::memory_order_relaxed);  // only while the writer is idle
+  count_.store(0, std::memory_order_relaxed);
+  max_.store(0, std::memory_order_relaxed);
+}
+
+void TaskStats::record_cycle(std::int64_t latency_ns, std::int64_t exec_ns, bool missed) noexcept {
+  latency_.record(latency_ns);
+  // Single writer (the task's thread); relaxed: each figure is read on its own.
+  cycles_.store(cycles_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+  if (missed) missed_.store(missed_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+  exec_sum_ns_.store(exec_sum_ns_.load(std::memory_order_relaxed) + exec_ns, std::memory_order_relaxed);
+  if (exec_ns > exec_max_ns_.load(std::memory_order_relaxed)) exec_max_ns_.store(exec_ns, std::memory_order_relaxed);
+}
+
+TaskStatsSnapshot TaskStats::snapshot() const noexcept {
+  TaskStatsSnapshot s;
+  s.cycles = cycles_.load(std::memory_order_relaxed);  // figures may be one cycle apart: fine for a table
+  s.missed = missed_.load(std::memory_order_relaxed);
+  const std::int64_t sum = exec_sum_ns_.load(std::memory_order_relaxed);
+  s.exec_mean_ns = s.cycles ? sum / static_cast<std::int64_t>(s.cycles) : 0;
+  s.exec_max_ns = exec_max_ns_.load(std::memory_order_relaxed);
+  s.latency_p50_ns = latency_.percentile(0.50);
+  s.latency_p99_ns = latency_.percentile(0.99);
+  s.latency_max_ns = latency_.max();
+  return s;
+}
+
+void TaskStats::reset() noexcept {
+  latency_.reset();
+  cycles_.store(0, std::memory_order_relaxed);  // only while the writer is idle
+  missed_.store(0, std::memory_order_relaxed);
+  exec_sum_ns_.store(0, std::memory_order_relaxed);
+  exec_max_ns_.store(0, std::memory_order_relaxed);
+}
+
+}  // namespace chimera

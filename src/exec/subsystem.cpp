@@ -1,0 +1,229 @@
+#include "chimera/exec/subsystem.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstring>
+#include <thread>
+
+#include <fmt/format.h>
+
+#include "chimera/exec/clock.hpp"
+#include "chimera/exec/task.hpp"
+#include "real_executive.hpp"
+#include "release_order.hpp"
+#include "value_codec.hpp"
+#include "virtual_executive.hpp"
+
+namespace chimera {
+
+namespace {
+class TableFlags final : public SubsystemFlags {
+ public:
+  explicit TableFlags(const GlobalTable* table) : table_(table) {}
+  [[nodiscard]] bool illegal_configuration() const noexcept override { return table_->illegal_configuration(); }
+
+ private:
+  const GlobalTable* table_;
+};
+
+std::string join_lines(const std::vector<Violation>& violations) {
+  std::string out;
+  for (const auto& v : violations) out += (out.empty() ? "" : "\n") + v.message;
+  return out;
+}
+}  // namespace
+
+struct Subsystem::Impl {
+  SubsystemSpec spec;
+  RunOptions options;
+  Resolution resolution;
+  std::string configuration;
+  std::unique_ptr<GlobalTable> table;
+  std::unique_ptr<TableFlags> flags;
+  std::vector<std::unique_ptr<Task>> tasks;
+  ReleaseOrder order;
+  std::unique_ptr<VirtualExecutive> virtual_exec;
+  std::unique_ptr<RealExecutive> real_exec;
+  std::vector<std::string> last_error;
+  bool stopped = false;
+
+  [[nodiscard]] std::int64_t now() const { return virtual_exec ? virtual_exec->now_ns() : real_exec->now_ns(); }
+  Result<void> signal(std::size_t i, Signal s) {
+    return virtual_exec ? virtual_exec->signal(i, s) : real_exec->signal(i, s);
+  }
+  std::optional<std::size_t> index_of(std::string_view name) const {
+    for (std::size_t i = 0; i < tasks.size(); ++i)
+      if (tasks[i]->name() == name) return i;
+    return std::nullopt;
+  }
+};
+
+Subsystem::Subsystem() : impl_(std::make_unique<Impl>()) {}
+Subsystem::~Subsystem() { stop(); }
+
+Result<std::unique_ptr<Subsystem>> Subsystem::create(const SubsystemSpec& spec, const Registry& registry,
+                                                      RunOptions options) {
+  std::unique_ptr<Subsystem> s(new Subsystem());
+  Impl& m = *s->impl_;
+  m.spec = spec;  // the resolution below points into this copy, which never moves
+  m.options = std::move(options);
+  m.configuration = m.options.configuration.value_or(m.spec.start);
+  if (m.spec.find_configuration(m.configuration) == nullptr)
+    return make_error(Errc::kNotFound, fmt::format("{}: no configuration named '{}'", spec.file, m.configuration));
+  const long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
+  for (const auto& t : m.spec.tasks)
+    if (t.cpu && *t.cpu >= ncpu)
+      return make_error(Errc::kInvalidInput, fmt::format("{}:{}: tasks.{}.cpu: cpu {} does not exist on this machine "
+                                                         "({} CPUs)", spec.file, t.loc.line, t.name, *t.cpu, ncpu));
+
+  m.resolution = resolve_subsystem(m.spec, registry);
+  auto violations = verify_subsystem(m.resolution, m.configuration);
+  if (!violations.empty())
+    return make_error(Errc::kIllegal, fmt::format("{}: configuration '{}' is not legal:\n{}", spec.file,
+                                                  m.configuration, join_lines(violations)));
+
+  auto table = GlobalTable::create(m.spec.name + m.options.shm_suffix, m.resolution.subsystem.variables);
+  if (!table) return table.error();
+  m.table = std::make_unique<GlobalTable>(std::move(*table));
+  m.flags = std::make_unique<TableFlags>(m.table.get());
+  for (const auto& [name, values] : m.spec.constants) {
+    if (auto v = m.table->find(name)) {
+      auto bytes = encode_values(m.table->shape(*v), values);
+      if (bytes) m.table->write(*v, bytes->data());
+    }
+  }
+
+  std::vector<Task*> raw;
+  for (const auto& rt : m.resolution.subsystem.tasks) {
+    m.tasks.push_back(std::make_unique<Task>(rt, *m.table, *m.flags));
+    raw.push_back(m.tasks.back().get());
+  }
+  m.last_error.assign(m.tasks.size(), {});
+  m.order = compute_release_order(m.resolution.subsystem);
+  if (m.options.clock == ClockKind::kVirtual) {
+    m.virtual_exec = std::make_unique<VirtualExecutive>(raw, m.order);
+  } else {
+    prepare_realtime_process(m.options.realtime_priorities);
+    m.real_exec = std::make_unique<RealExecutive>(raw, m.order, m.spec, m.options.realtime_priorities);
+  }
+  return s;
+}
+
+Result<void> Subsystem::start() {
+  Impl& m = *impl_;
+  const ConfigurationSpec* config = m.spec.find_configuration(m.configuration);
+  std::vector<std::size_t> members;
+  for (const auto& name : config->tasks) members.push_back(*m.index_of(name));
+  auto abandon = [&](const Error& e) -> Result<void> {
+    for (auto it = members.rbegin(); it != members.rend(); ++it)
+      if (m.tasks[*it]->state() != TaskState::kNotCreated) (void)m.signal(*it, Signal::kKill);
+    return e;
+  };
+  for (const std::size_t i : members)
+    if (auto r = m.signal(i, Signal::kSpawn); !r) return abandon(r.error());
+  for (const std::size_t i : members)
+    if (auto r = m.signal(i, Signal::kOn); !r) return abandon(r.error());
+  return {};
+}
+
+Result<void> Subsystem::signal(std::string_view task, Signal signal) {
+  Impl& m = *impl_;
+  const auto i = m.index_of(task);
+  if (!i) return make_error(Errc::kNotFound, fmt::format("no task named '{}'", task));
+  return m.signal(*i, signal);
+}
+
+void Subsystem::run_for(std::int64_t ns) {
+  Impl& m = *impl_;
+  if (ns <= 0) return;
+  if (m.virtual_exec) {
+    m.virtual_exec->run_until(m.virtual_exec->now_ns() + ns);
+  } else {
+    std::this_thread::sleep_for(std::chrono::nanoseconds(ns));
+  }
+}
+
+void Subsystem::stop() {
+  Impl& m = *impl_;
+  if (m.stopped || !m.table) return;
+  m.stopped = true;
+  // The paper's two-step termination: every task off, then every task killed.
+  for (std::size_t i = 0; i < m.tasks.size(); ++i)
+    if (m.tasks[i]->state() == TaskState::kOn) (void)m.signal(i, Signal::kOff);
+  for (std::size_t i = 0; i < m.tasks.size(); ++i)
+    if (m.tasks[i]->state() != TaskState::kNotCreated) (void)m.signal(i, Signal::kKill);
+  m.real_exec.reset();
+  m.virtual_exec.reset();
+  m.tasks.clear();
+  m.table.reset();  // unlinks the shared memory
+}
+
+std::int64_t Subsystem::now_ns() const { return impl_->now(); }
+ClockKind Subsystem::clock() const { return impl_->options.clock; }
+const SubsystemSpec& Subsystem::spec() const { return impl_->spec; }
+const ResolvedSubsystem& Subsystem::resolved() const { return impl_->resolution.subsystem; }
+GlobalTable& Subsystem::table() { return *impl_->table; }
+
+Result<std::vector<double>> Subsystem::get(std::string_view variable) const {
+  const Impl& m = *impl_;
+  const auto v = m.table->find(variable);
+  if (!v) return make_error(Errc::kNotFound, fmt::format("no state variable named '{}'", variable));
+  std::vector<std::byte> bytes(m.table->shape(*v).bytes());
+  const ReadOutcome r = m.table->read(*v, bytes.data(), 0);
+  if (r.freshness == Freshness::kNoData)
+    return make_error(Errc::kNotFound, fmt::format("{} has not been written yet", variable));
+  return decode_values(m.table->shape(*v), bytes.data());
+}
+
+Result<void> Subsystem::set(std::string_view variable, const std::vector<double>& values) {
+  Impl& m = *impl_;
+  const auto v = m.table->find(variable);
+  if (!v) return make_error(Errc::kNotFound, fmt::format("no state variable named '{}'", variable));
+  for (const auto& [name, value] : m.spec.constants)
+    if (name == variable) return make_error(Errc::kState, fmt::format("{} is a subsystem constant", variable));
+  for (const auto& t : m.tasks) {
+    if (t->state() != TaskState::kOn) continue;
+    for (const auto& b : t->resolved().bindings)
+      if (!is_input(b.kind) && b.variable == variable)
+        return make_error(Errc::kState, fmt::format("{} is produced by task '{}', which is ON", variable, t->name()));
+  }
+  auto bytes = encode_values(m.table->shape(*v), values);
+  if (!bytes) return bytes.error();
+  m.table->write(*v, bytes->data());
+  return {};
+}
+
+std::vector<TaskSnapshot> Subsystem::snapshot() const {
+  const Impl& m = *impl_;
+  std::vector<TaskSnapshot> out;
+  for (std::size_t i = 0; i < m.tasks.size(); ++i) {
+    const Task& t = *m.tasks[i];
+    out.push_back(TaskSnapshot{t.name(), t.spec().module, t.state(), t.period_ns(), t.spec().cpu.value_or(-1),
+                               t.stats().snapshot(), m.last_error[i]});
+  }
+  return out;
+}
+
+std::vector<Event> Subsystem::drain_events() {
+  Impl& m = *impl_;
+  std::vector<Event> out;
+  RtEvent e;
+  for (std::size_t i = 0; i < m.tasks.size(); ++i) {
+    while (m.tasks[i]->events().pop(e)) {
+      out.push_back(Event{e.time_ns, m.tasks[i]->name(), e.text.data()});
+      if (std::strstr(e.text.data(), "ERROR") != nullptr || std::strstr(e.text.data(), "failed") != nullptr)
+        m.last_error[i] = e.text.data();
+    }
+  }
+  std::stable_sort(out.begin(), out.end(), [](const Event& a, const Event& b) { return a.time_ns < b.time_ns; });
+  return out;
+}
+
+bool Subsystem::hard_task_failed() const {
+  for (const auto& t : impl_->tasks)
+    if (t->hard() && t->ever_in_error()) return true;
+  return false;
+}
+
+}  // namespace chimera

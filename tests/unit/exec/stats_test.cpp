@@ -1,0 +1,44 @@
+#include "chimera/exec/stats.hpp"
+
+#include <gtest/gtest.h>
+
+namespace chimera {
+namespace {
+
+TEST(LatencyHistogram, BucketsAreMonotonicAndTight) {
+  int previous = -1;
+  for (std::int64_t v : {0L, 1L, 31L, 32L, 33L, 63L, 64L, 1000L, 1'000'000L, 1'000'000'000L}) {
+    const int b = LatencyHistogram::bucket_of(v);
+    EXPECT_GT(b, previous) << v;
+    previous = b;
+    EXPECT_GE(LatencyHistogram::upper_bound_of(b), v);
+    EXPECT_LE(LatencyHistogram::upper_bound_of(b), v + v / 16 + 1) << "about 3% resolution at " << v;
+  }
+}
+
+TEST(LatencyHistogram, PercentilesOfAKnownDistribution) {
+  LatencyHistogram h;
+  for (int i = 1; i <= 1000; ++i) h.record(i * 1000);  // 1 us .. 1 ms
+  EXPECT_EQ(h.count(), 1000u);
+  EXPECT_EQ(h.max(), 1'000'000);
+  EXPECT_NEAR(static_cast<double>(h.percentile(0.5)), 500'000.0, 500'000.0 * 0.04);
+  EXPECT_NEAR(static_cast<double>(h.percentile(0.99)), 990'000.0, 990'000.0 * 0.04);
+  EXPECT_EQ(h.percentile(1.0), 1'000'000);
+  h.reset();
+  EXPECT_EQ(h.percentile(0.5), 0);
+}
+
+TEST(TaskStats, CountsCyclesMissesAndExecutionTimes) {
+  TaskStats s;
+  s.record_cycle(100, 1000, false);
+  s.record_cycle(300, 3000, true);
+  const auto snap = s.snapshot();
+  EXPECT_EQ(snap.cycles, 2u);
+  EXPECT_EQ(snap.missed, 1u);
+  EXPECT_EQ(snap.exec_mean_ns, 2000);
+  EXPECT_EQ(snap.exec_max_ns, 3000);
+  EXPECT_EQ(snap.latency_max_ns, 300);
+}
+
+}  // namespace
+}  // namespace chimera
