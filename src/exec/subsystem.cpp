@@ -87,7 +87,9 @@ Result<std::unique_ptr<Subsystem>> Subsystem::create(const SubsystemSpec& spec, 
   if (!table) return table.error();
   m.table = std::make_unique<GlobalTable>(std::move(*table));
   m.flags = std::make_unique<TableFlags>(m.table.get());
-  for (const auto& [name, values] : m.spec.constants) {
+  // Constants known up front (the file's and the out-consts modules declare) are in the table
+  // before any init, so that an in-const reads its value whatever order tasks are spawned in.
+  for (const auto& [name, values] : m.resolution.subsystem.constant_values) {
     if (auto v = m.table->find(name)) {
       auto bytes = encode_values(m.table->shape(*v), values);
       if (bytes) m.table->write(*v, bytes->data());

@@ -139,7 +139,7 @@ Result<void> Task::spawn(std::int64_t now_ns) {
 
 Result<void> Task::turn_on(std::int64_t now_ns) {
   // A task joining starts from a fresh local table: inputs read anew, nothing stale kept.
-  local_->reset();
+  local_->reset_inputs();
   local_->pull_in_consts();
   timing_.release_ns = now_ns;
   const Status s = call(Hook::kOn);

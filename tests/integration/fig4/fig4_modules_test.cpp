@@ -1,0 +1,246 @@
+// The three modules of Figure 4 one by one: their declared ports against the contract (section 3),
+// the trajectory and PID laws, and no allocation while the closed loop cycles.
+
+#include <unistd.h>
+
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <cstdlib>
+#include <new>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "chimera/config/loader.hpp"
+#include "chimera/exec/subsystem.hpp"
+#include "chimera/module/registry.hpp"
+#include "joint_traj_gen/quintic_via.hpp"
+#include "pid_joint/pid_law.hpp"
+
+// A sanitizer brings its own allocator; replacing operator new beside it proves nothing, so the
+// allocation count is a check of the plain build only (as in tests/rt).
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define CHIMERA_COUNT_ALLOCATIONS 0
+#else
+#define CHIMERA_COUNT_ALLOCATIONS 1
+#endif
+
+namespace {
+
+// Counts C++ allocations while armed: the closed loop must make none.
+std::atomic<bool> g_counting{false};  // NOLINT(cppcoreguidelines-avoid-non-const-global-variables): the hook's switch
+std::atomic<int> g_allocations{0};    // NOLINT(cppcoreguidelines-avoid-non-const-global-variables): the hook's count
+
+}  // namespace
+
+#if CHIMERA_COUNT_ALLOCATIONS
+// noinline: GCC 12 otherwise pairs the inlined free() with operator new and warns
+// (-Wmismatched-new-delete), although the replacements are a matched pair.
+[[gnu::noinline]] void* operator new(std::size_t size) {
+  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
+  // NOLINTNEXTLINE(cppcoreguidelines-no-malloc): this is the allocator
+  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
+  throw std::bad_alloc();
+}
+[[gnu::noinline]] void operator delete(void* p) noexcept { std::free(p); }  // NOLINT(cppcoreguidelines-no-malloc)
+[[gnu::noinline]] void operator delete(void* p, std::size_t /*size*/) noexcept {
+  std::free(p);  // NOLINT(cppcoreguidelines-no-malloc): this is the allocator
+}
+#endif
+
+namespace chimera {
+namespace {
+
+constexpr std::int64_t kMs = 1'000'000;
+constexpr std::int64_t kS = 1'000'000'000;
+
+// ---- ports: the names, kinds and sizes the contract gives --------------------------------------
+
+struct Expected {
+  std::string name;
+  PortKind kind;
+  std::string dim;
+};
+
+void expect_ports(const char* module, const std::vector<Expected>& expected) {
+  const ModuleInfo* info = Registry::global().find(module);
+  ASSERT_NE(info, nullptr) << module << " is not registered";
+  EXPECT_FALSE(info->summary.empty());
+  EXPECT_GT(info->doc.size(), 300U) << module << ": kDoc should be a real paragraph";
+  const Declarations d = info->declarations(Params{});
+  ASSERT_EQ(d.ports().size(), expected.size()) << module;
+  for (const auto& e : expected) {
+    bool found = false;
+    for (const auto& p : d.ports()) {
+      if (p.name != e.name) continue;
+      found = true;
+      EXPECT_EQ(p.kind, e.kind) << module << "." << e.name;
+      EXPECT_EQ(p.type, ElemType::kF64) << module << "." << e.name;
+      EXPECT_EQ(to_string(p.dim), e.dim) << module << "." << e.name;
+    }
+    EXPECT_TRUE(found) << module << " lacks port " << e.name;
+  }
+}
+
+TEST(Fig4Modules, PortsFollowTheContract) {
+  expect_ports("joint_traj_gen", {{"ndof", PortKind::kInConst, "1"},
+                                  {"theta_m", PortKind::kInVar, "ndof"},
+                                  {"theta_d", PortKind::kOutVar, "ndof"},
+                                  {"dtheta_d", PortKind::kOutVar, "ndof"}});
+  expect_ports("pid_joint", {{"ndof", PortKind::kInConst, "1"},
+                             {"theta_d", PortKind::kInVar, "ndof"},
+                             {"dtheta_d", PortKind::kInVar, "ndof"},
+                             {"theta_m", PortKind::kInVar, "ndof"},
+                             {"dtheta_m", PortKind::kInVar, "ndof"},
+                             {"tau_r", PortKind::kOutVar, "ndof"}});
+  // The robot's sizes come from its own ndof parameter (6 by default).
+  expect_ports("robot_torque", {{"tau_r", PortKind::kInVar, "6"},
+                                {"theta_m", PortKind::kOutVar, "6"},
+                                {"dtheta_m", PortKind::kOutVar, "6"},
+                                {"ndof", PortKind::kOutConst, "1"}});
+  const Declarations robot = Registry::global().find("robot_torque")->declarations(Params{});
+  EXPECT_FALSE(robot.resource().empty());
+  for (const auto& p : robot.ports()) {
+    if (p.name == "ndof") {
+      EXPECT_EQ(p.value, std::vector<double>{6.0});
+    }
+  }
+}
+
+// ---- joint_traj_gen's law ----------------------------------------------------------------------
+
+constexpr std::size_t kN = 2;
+
+modules::QuinticVia make_path(bool loop) {
+  modules::QuinticVia path;
+  path.configure(kN, {1.0, -2.0, 3.0, 0.0}, 2 * kS, kS / 2, loop);  // vias (1,-2) and (3,0)
+  const std::vector<double> start{0.0, 0.0};
+  path.restart(start);
+  return path;
+}
+
+std::vector<double> pos_at(const modules::QuinticVia& p, std::int64_t t, std::vector<double>* vel = nullptr) {
+  std::vector<double> q(kN);
+  std::vector<double> v(kN);
+  p.sample(t, q, v);
+  if (vel) *vel = v;
+  return q;
+}
+
+TEST(Fig4Modules, QuinticStartsAndEndsAtRest) {
+  const auto path = make_path(true);
+  std::vector<double> v;
+  EXPECT_EQ(pos_at(path, 0, &v), (std::vector<double>{0.0, 0.0}));
+  EXPECT_EQ(v, (std::vector<double>{0.0, 0.0}));
+  EXPECT_EQ(pos_at(path, 2 * kS, &v), (std::vector<double>{1.0, -2.0}));  // at the via point...
+  EXPECT_EQ(v, (std::vector<double>{0.0, 0.0}));
+  EXPECT_EQ(pos_at(path, 2 * kS + kS / 4), (std::vector<double>{1.0, -2.0}));  // ...and resting there
+  // Halfway: half the distance, at the quintic's peak speed 15/8 * distance / duration.
+  const auto mid = pos_at(path, kS, &v);
+  EXPECT_DOUBLE_EQ(mid[0], 0.5);
+  EXPECT_DOUBLE_EQ(v[0], 15.0 / 8.0 * 1.0 / 2.0);
+  EXPECT_DOUBLE_EQ(v[1], 15.0 / 8.0 * -2.0 / 2.0);
+  // Near the ends the speed vanishes like t^2 (zero acceleration too).
+  pos_at(path, kMs, &v);
+  EXPECT_LT(std::fabs(v[0]), 1e-5);
+}
+
+TEST(Fig4Modules, QuinticVelocityIsTheDerivativeOfPosition) {
+  const auto path = make_path(true);
+  for (std::int64_t t = 0; t < 12 * kS; t += 37 * kMs) {
+    std::vector<double> v;
+    const auto q0 = pos_at(path, t, &v);
+    const auto q1 = pos_at(path, t + kMs);
+    for (std::size_t j = 0; j < kN; ++j) EXPECT_NEAR((q1[j] - q0[j]) / 1e-3, v[j], 0.01) << "t " << t << " j " << j;
+  }
+}
+
+TEST(Fig4Modules, QuinticLoopsThroughTheViaPointsOrHoldsTheLast) {
+  const auto looping = make_path(true);
+  const auto once = make_path(false);
+  const std::int64_t leg = 2 * kS + kS / 2;
+  // Second leg ends at via 2, third leg goes back to via 1, and so on forever.
+  EXPECT_EQ(pos_at(looping, 2 * leg - kS / 4), (std::vector<double>{3.0, 0.0}));
+  EXPECT_EQ(pos_at(looping, 3 * leg - kS / 4), (std::vector<double>{1.0, -2.0}));
+  EXPECT_EQ(pos_at(looping, 1001 * leg - kS / 4), (std::vector<double>{1.0, -2.0}));
+  EXPECT_EQ(pos_at(once, 3 * leg - kS / 4), (std::vector<double>{3.0, 0.0}));
+  EXPECT_EQ(pos_at(once, 1000 * leg), (std::vector<double>{3.0, 0.0}));
+}
+
+// ---- pid_joint's law ---------------------------------------------------------------------------
+
+modules::PidLaw make_pid(double kp, double ki, double kd, double tau_max, double i_max) {
+  modules::PidLaw pid;
+  pid.configure({{kp}, {ki}, {kd}, {tau_max}, {i_max}}, 0.001);
+  return pid;
+}
+
+double pid_out(modules::PidLaw& pid, double qd, double dqd, double qm, double dqm) {
+  const std::array<double, 4> in{qd, dqd, qm, dqm};
+  const std::span<const double> all(in);
+  double tau = 0.0;
+  pid.update(all.subspan(0, 1), all.subspan(1, 1), all.subspan(2, 1), all.subspan(3, 1), {&tau, 1});
+  return tau;
+}
+
+TEST(Fig4Modules, PidIsProportionalIntegralAndDerivative) {
+  auto pid = make_pid(100.0, 50.0, 10.0, 1e6, 1e6);
+  // First sample: e = 0.2 integrated once over 1 ms.
+  EXPECT_DOUBLE_EQ(pid_out(pid, 0.2, 1.0, 0.0, 0.5), 100.0 * 0.2 + 50.0 * 0.2 * 0.001 + 10.0 * 0.5);
+  EXPECT_DOUBLE_EQ(pid.integral()[0], 0.2 * 0.001);
+  pid.reset();
+  EXPECT_EQ(pid.integral()[0], 0.0);
+}
+
+TEST(Fig4Modules, PidSaturatesAndDoesNotWindUp) {
+  auto pid = make_pid(100.0, 1000.0, 0.0, 20.0, 1e6);
+  // A large error saturates the output; the integral must not grow meanwhile.
+  for (int k = 0; k < 1000; ++k) EXPECT_DOUBLE_EQ(pid_out(pid, 1.0, 0.0, 0.0, 0.0), 20.0);
+  EXPECT_EQ(pid.integral()[0], 0.0);
+  // So once the error reverses the output follows at once, with no stored windup to unwind.
+  EXPECT_LT(pid_out(pid, 0.0, 0.0, 0.1, 0.0), -9.0);
+  EXPECT_DOUBLE_EQ(pid_out(pid, -1.0, 0.0, 0.0, 0.0), -20.0);
+}
+
+TEST(Fig4Modules, PidIntegralIsBounded) {
+  auto pid = make_pid(0.0, 1.0, 0.0, 1e6, 0.01);
+  for (int k = 0; k < 100'000; ++k) (void)pid_out(pid, 1.0, 0.0, 0.0, 0.0);
+  EXPECT_DOUBLE_EQ(pid.integral()[0], 0.01);
+  EXPECT_DOUBLE_EQ(pid_out(pid, 1.0, 0.0, 0.0, 0.0), 0.01);
+}
+
+// ---- the closed loop allocates nothing while it cycles ------------------------------------------
+
+TEST(Fig4Modules, CyclesDoNotAllocate) {
+  if (!CHIMERA_COUNT_ALLOCATIONS) GTEST_SKIP() << "allocations are not counted under a sanitizer";
+  const char* text = R"(subsystem: fig4_noalloc
+tasks:
+  - { name: traj, module: joint_traj_gen, period: 1ms }
+  - { name: pid, module: pid_joint, period: 1ms }
+  - { name: robot, module: robot_torque, period: 1ms, params: { noise_std: 0.001 } }
+configurations:
+  pid_control: [traj, pid, robot]
+)";
+  auto spec = load_subsystem_text(text, "fig4_noalloc.yaml", Registry::global());
+  ASSERT_TRUE(spec.ok()) << spec.error().message;
+  RunOptions options;
+  options.clock = ClockKind::kVirtual;
+  options.shm_suffix = "_fig4_noalloc_" + std::to_string(::getpid());
+  auto sub = Subsystem::create(*spec, Registry::global(), options);
+  ASSERT_TRUE(sub.ok()) << sub.error().message;
+  auto started = (*sub)->start();
+  ASSERT_TRUE(started.ok()) << started.error().message;
+  (*sub)->run_for(10 * kMs);  // let anything lazy happen first
+  g_allocations = 0;
+  g_counting = true;
+  (*sub)->run_for(500 * kMs);
+  g_counting = false;
+  EXPECT_EQ(g_allocations.load(), 0) << "allocations during 500 cycles of each task";
+  (*sub)->stop();
+}
+
+}  // namespace
+}  // namespace chimera
