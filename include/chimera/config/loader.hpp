@@ -2,8 +2,10 @@
 // Loading a subsystem file. Every problem is reported as "file:line: key: problem", and a file
 // with any problem is refused whole.
 
+#include <cstdint>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "chimera/config/subsystem.hpp"
 #include "chimera/core/result.hpp"
@@ -11,7 +13,9 @@
 
 namespace chimera {
 
-/// Parses "10ms", "250us", "1s", "500ns" to nanoseconds, and "100Hz", "1kHz" to a period.
+/// Parses "10ms", "250us", "1s", "500ns", "2.5ms" (no space, not negative, at most 1ns
+/// resolution) to nanoseconds, and "100Hz", "1kHz", "33.3Hz" to a period rounded to 1ns.
+/// Zero durations are accepted; callers that need a positive one check it. Not real-time safe.
 Result<std::int64_t> parse_duration_ns(std::string_view text);
 Result<std::int64_t> parse_frequency_period_ns(std::string_view text);
 
@@ -21,5 +25,12 @@ Result<SubsystemSpec> load_subsystem_file(const std::string& path, const Registr
 /// The same for text already in memory; `file_name` is used in messages.
 Result<SubsystemSpec> load_subsystem_text(std::string_view text, const std::string& file_name,
                                           const Registry& registry);
+
+/// Only the `plugins:` list of a subsystem file, so that a caller can load the module libraries
+/// it names before load_subsystem_file() checks the tasks' modules against the registry.
+/// Errors carry Errc::kInvalidInput. Not real-time safe.
+Result<std::vector<std::string>> read_plugin_names_file(const std::string& path);
+/// The same for text already in memory; `file_name` is used in messages.
+Result<std::vector<std::string>> read_plugin_names_text(std::string_view text, const std::string& file_name);
 
 }  // namespace chimera

@@ -26,10 +26,10 @@ struct SourceLoc {
 };
 
 struct TaskSpec {
-  std::string name;    // instance name, unique in the file
-  std::string module;  // module type in the registry
+  std::string name;                       // instance name, unique in the file
+  std::string module;                     // module type in the registry
   std::optional<std::int64_t> period_ns;  // absent: aperiodic
-  std::int64_t deadline_ns = 0;           // defaults to the period
+  std::int64_t deadline_ns = 0;           // defaults to the period; 0: none (aperiodic, not given)
   Criticality criticality = Criticality::kHard;
   std::optional<std::int64_t> wcet_ns;
   std::optional<int> cpu;

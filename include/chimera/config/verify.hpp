@@ -5,6 +5,7 @@
 
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "chimera/config/subsystem.hpp"
@@ -29,7 +30,9 @@ struct ResolvedTask {
 struct ResolvedSubsystem {
   const SubsystemSpec* spec = nullptr;
   std::vector<ResolvedTask> tasks;  // same order as spec->tasks
-  std::vector<VarSpec> variables;   // union of every task's variables and `constants`, sorted
+  // Union of every task's variables and `constants`, sorted by name. A variable whose size no
+  // port could fix has count 0 (verification reports why, for the configurations that use it).
+  std::vector<VarSpec> variables;
   /// Values of every constant known up front: `constants` and declared out-consts.
   std::vector<std::pair<std::string, std::vector<double>>> constant_values;
 
@@ -41,7 +44,10 @@ struct ResolvedSubsystem {
 };
 
 /// One broken rule. `rule` is 1, 2 or 3; `configuration` is empty for file-wide problems
-/// (e.g. one variable with two shapes, or a size that cannot be fixed).
+/// (e.g. one variable with two shapes, or a size that cannot be fixed). Rule 0 marks a problem
+/// that is none of the paper's rules: a task or configuration name that does not exist, or a
+/// module whose declarations size a port by something that is not one of its const ports.
+/// `tasks` holds task names only (a `constants:` entry is named in the message).
 struct Violation {
   int rule = 0;
   std::string configuration;
@@ -59,11 +65,23 @@ struct Resolution {
 Resolution resolve_subsystem(const SubsystemSpec& spec, const Registry& registry);
 
 /// Checks rules 1 to 3 for the named tasks (one configuration, or any set of tasks that should
-/// be ON together). Not real-time safe.
+/// be ON together). Messages start with "configuration 'NAME': " unless `configuration_name` is
+/// empty; a name that is not a task of the file gives a rule-0 violation. Not real-time safe.
 std::vector<Violation> verify_tasks(const ResolvedSubsystem& subsystem, const std::vector<std::string>& task_names,
                                     const std::string& configuration_name);
 
-/// Every configuration of the file (or only `only`), plus the file-wide violations of `resolution`.
+/// Every configuration of the file (or only `only`), plus the file-wide violations of `resolution`:
+/// file-wide ones first, then each configuration's in file order; within one configuration rule 1,
+/// then 2, then 3, each by variable name. An `only` that names no configuration adds a rule-0
+/// violation; callers that must tell that apart (`chimera verify` exits 2) ask
+/// check_configuration_name() first. Not real-time safe.
 std::vector<Violation> verify_subsystem(const Resolution& resolution, const std::optional<std::string>& only = {});
+
+/// Succeeds if `name` is a configuration of `spec`; otherwise Errc::kNotFound with a message
+/// that lists the configurations. Not real-time safe.
+Result<void> check_configuration_name(const SubsystemSpec& spec, std::string_view name);
+
+/// One line per violation (its message), each ending in a newline; "" when there are none.
+std::string format_violations(const std::vector<Violation>& violations);
 
 }  // namespace chimera

@@ -1,0 +1,183 @@
+#include "config/detail/task_loader.hpp"
+
+#include <algorithm>
+#include <string>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+namespace chimera::config_detail {
+namespace {
+
+Result<const ModuleInfo*> read_module(const Source& source, const Field& field, const Registry& registry) {
+  auto name = read_text(source, field);
+  if (!name) return name.error();
+  if (const ModuleInfo* info = registry.find(*name)) return info;
+  std::vector<std::string> known;
+  for (const ModuleInfo* m : registry.list()) known.push_back(m->name);
+  if (known.empty()) return source.fail(field, fmt::format("no module named {} (the module library is empty)", *name));
+  return source.fail(field, fmt::format("no module named {} (known: {})", *name, fmt::join(known, ", ")));
+}
+
+// period | frequency, deadline, wcet. Zero periods and budgets are refused here because
+// parse_duration_ns accepts "0ms" as a duration.
+Result<void> read_timing(const Source& source, const MapReader& map, TaskSpec& task) {
+  const auto period = map.get("period");
+  const auto frequency = map.get("frequency");
+  if (period && frequency) return source.fail(*frequency, "give period or frequency, not both");
+  if (period || frequency) {
+    const Field& f = period ? *period : *frequency;
+    auto ns = period ? read_duration(source, f) : read_frequency_period(source, f);
+    if (!ns) return ns.error();
+    if (*ns <= 0) return source.fail(f, "must be greater than zero");
+    task.period_ns = *ns;
+  }
+  task.deadline_ns = task.period_ns.value_or(0);  // an aperiodic task without a deadline has none (0)
+  if (const auto f = map.get("deadline")) {
+    auto ns = read_duration(source, *f);
+    if (!ns) return ns.error();
+    if (*ns <= 0) return source.fail(*f, "must be greater than zero");
+    task.deadline_ns = *ns;
+  }
+  if (const auto f = map.get("wcet")) {
+    auto ns = read_duration(source, *f);
+    if (!ns) return ns.error();
+    if (*ns <= 0) return source.fail(*f, "must be greater than zero");
+    task.wcet_ns = *ns;
+  }
+  return {};
+}
+
+Result<void> read_criticality(const Source& source, const MapReader& map, TaskSpec& task) {
+  const auto f = map.get("criticality");
+  if (!f) return {};
+  const std::string text = f->node.IsScalar() ? f->node.Scalar() : std::string();
+  if (text == "hard") {
+    task.criticality = Criticality::kHard;
+  } else if (text == "soft") {
+    task.criticality = Criticality::kSoft;
+  } else {
+    return source.fail(*f, fmt::format("{} is not a criticality (use hard or soft)", describe(f->node)));
+  }
+  return {};
+}
+
+Result<void> read_cpu(const Source& source, const MapReader& map, const std::vector<int>& cpus, TaskSpec& task) {
+  const auto f = map.get("cpu");
+  if (!f) return {};
+  auto cpu = read_index(source, *f);
+  if (!cpu) return cpu.error();
+  if (!cpus.empty() && std::find(cpus.begin(), cpus.end(), *cpu) == cpus.end())
+    return source.fail(*f, fmt::format("cpu {} is not one of the subsystem's cpus [{}]", *cpu, fmt::join(cpus, ", ")));
+  task.cpu = *cpu;
+  return {};
+}
+
+std::string_view with_article(ParamType t) {
+  switch (t) {
+    case ParamType::kNumber: return "a number";
+    case ParamType::kBool: return "a boolean (true or false)";
+    case ParamType::kString: return "a string";
+    case ParamType::kVector: return "a list of numbers";
+    case ParamType::kMatrix: return "a list of lists of numbers";
+  }
+  return "?";
+}
+
+// Checks `params:` against the module's declared parameters and fills in the defaults.
+Result<Params> read_params(const Source& source, const std::optional<Field>& field, const ModuleInfo& info) {
+  const Declarations declared = info.declarations(Params{});
+  Params params;
+  if (field) {
+    if (auto ok = check_free_keys(source, *field, "params"); !ok) return ok.error();
+    for (const auto& [value, name] : entries(*field)) {
+      const auto decl = std::find_if(declared.params().begin(), declared.params().end(),
+                                     [&](const ParamDecl& p) { return p.name == name; });
+      if (decl == declared.params().end()) {
+        std::vector<std::string> known;
+        for (const auto& p : declared.params()) known.push_back(p.name);
+        std::sort(known.begin(), known.end());
+        if (known.empty()) return source.fail(value, fmt::format("unknown parameter ({} takes none)", info.name));
+        return source.fail(value,
+                           fmt::format("unknown parameter of {} (known: {})", info.name, fmt::join(known, ", ")));
+      }
+      auto v = read_param_value(source, value);
+      if (!v) return v.error();
+      // An empty list is as much an empty matrix as an empty vector.
+      if (decl->type == ParamType::kMatrix && std::holds_alternative<Vector>(*v) && std::get<Vector>(*v).empty())
+        *v = Matrix{};
+      if (param_type_of(*v) != decl->type)
+        return source.fail(
+            value, fmt::format("{} is {}, but {} of {} takes {}", to_string(*v), with_article(param_type_of(*v)), name,
+                               info.name, with_article(decl->type)));
+      params.set(name, *std::move(v));
+    }
+  }
+  for (const auto& p : declared.params())
+    if (!params.has(p.name)) params.set(p.name, p.default_value);
+  return params;
+}
+
+Result<void> read_rename(const Source& source, const Field& field, const ModuleInfo& info, TaskSpec& task) {
+  if (auto ok = check_free_keys(source, field, "rename"); !ok) return ok.error();
+  const Declarations decls = info.declarations(task.params);
+  std::vector<std::string> ports;
+  for (const auto& p : decls.ports()) ports.push_back(p.name);
+  for (const auto& [value, port] : entries(field)) {
+    if (std::find(ports.begin(), ports.end(), port) == ports.end()) {
+      if (ports.empty()) return source.fail(value, fmt::format("{} has no ports to rename", info.name));
+      return source.fail(value, fmt::format("{} has no port {} (ports: {})", info.name, port, fmt::join(ports, ", ")));
+    }
+    auto variable = read_identifier(source, value, "variable name");
+    if (!variable) return variable.error();
+    task.rename[port] = *std::move(variable);
+  }
+  // One variable per port: a task bound twice to one variable would write or read it twice.
+  for (const auto& [value, port] : entries(field)) {
+    const std::string variable = task.variable_of(port);
+    for (const auto& other : ports)
+      if (other != port && task.variable_of(other) == variable)
+        return source.fail(value, fmt::format("ports {} and {} of {} would both be bound to variable {}", port, other,
+                                              task.name, variable));
+  }
+  return {};
+}
+
+}  // namespace
+
+Result<TaskSpec> load_task(const Source& source, const Field& task_field, const SubsystemSpec& file,
+                           const Registry& registry) {
+  auto map = MapReader::create(
+      source, task_field, "a task",
+      {"name", "module", "period", "frequency", "deadline", "criticality", "wcet", "cpu", "params", "rename"});
+  if (!map) return map.error();
+  TaskSpec task;
+  task.loc = SourceLoc{source.file(), task_field.line};
+
+  auto name_field = map->require(source, "name", "every task has a unique name");
+  if (!name_field) return name_field.error();
+  auto name = read_identifier(source, *name_field, "task name");
+  if (!name) return name.error();
+  if (const TaskSpec* first = file.find_task(*name))
+    return source.fail(*name_field, fmt::format("task {} is already defined at line {}", *name, first->loc.line));
+  task.name = *std::move(name);
+
+  auto module_field = map->require(source, "module", "the module type this task runs, e.g. pid_joint");
+  if (!module_field) return module_field.error();
+  auto info = read_module(source, *module_field, registry);
+  if (!info) return info.error();
+  task.module = (*info)->name;
+
+  if (auto ok = read_timing(source, *map, task); !ok) return ok.error();
+  if (auto ok = read_criticality(source, *map, task); !ok) return ok.error();
+  if (auto ok = read_cpu(source, *map, file.cpus, task); !ok) return ok.error();
+  auto params = read_params(source, map->get("params"), **info);
+  if (!params) return params.error();
+  task.params = *std::move(params);
+  if (const auto rename = map->get("rename")) {
+    if (auto ok = read_rename(source, *rename, **info, task); !ok) return ok.error();
+  }
+  return task;
+}
+
+}  // namespace chimera::config_detail
