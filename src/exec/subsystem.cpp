@@ -3,7 +3,9 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cassert>
 #include <cstring>
+#include <mutex>
 #include <thread>
 
 #include <fmt/format.h>
@@ -46,9 +48,28 @@ struct Subsystem::Impl {
   std::unique_ptr<VirtualExecutive> virtual_exec;
   std::unique_ptr<RealExecutive> real_exec;
   std::vector<std::string> last_error;
+  std::vector<Event> pending;  // collected from the tasks' rings, not yet handed to a caller
+  std::mutex events_mutex;     // guards pending and last_error; never taken by a task's thread
+  std::int64_t stopped_at_ns = 0;
   bool stopped = false;
 
-  [[nodiscard]] std::int64_t now() const { return virtual_exec ? virtual_exec->now_ns() : real_exec->now_ns(); }
+  /// Moves every task's real-time events into `pending` and notes the last failure of each.
+  void collect_events() {
+    std::lock_guard<std::mutex> lock(events_mutex);
+    RtEvent e;
+    for (std::size_t i = 0; i < tasks.size(); ++i) {
+      while (tasks[i]->events().pop(e)) {
+        pending.push_back(Event{e.time_ns, tasks[i]->name(), e.text.data()});
+        if (std::strstr(e.text.data(), "ERROR") != nullptr || std::strstr(e.text.data(), "failed") != nullptr)
+          last_error[i] = e.text.data();
+      }
+    }
+  }
+
+  [[nodiscard]] std::int64_t now() const {
+    if (stopped) return stopped_at_ns;
+    return virtual_exec ? virtual_exec->now_ns() : real_exec->now_ns();
+  }
   Result<void> signal(std::size_t i, Signal s) {
     return virtual_exec ? virtual_exec->signal(i, s) : real_exec->signal(i, s);
   }
@@ -131,14 +152,17 @@ Result<void> Subsystem::start() {
 
 Result<void> Subsystem::signal(std::string_view task, Signal signal) {
   Impl& m = *impl_;
+  if (m.stopped) return make_error(Errc::kState, "the subsystem is stopped");
   const auto i = m.index_of(task);
   if (!i) return make_error(Errc::kNotFound, fmt::format("no task named '{}'", task));
-  return m.signal(*i, signal);
+  auto r = m.signal(*i, signal);
+  m.collect_events();
+  return r;
 }
 
 void Subsystem::run_for(std::int64_t ns) {
   Impl& m = *impl_;
-  if (ns <= 0) return;
+  if (ns <= 0 || m.stopped) return;
   if (m.virtual_exec) {
     m.virtual_exec->run_until(m.virtual_exec->now_ns() + ns);
   } else {
@@ -149,26 +173,31 @@ void Subsystem::run_for(std::int64_t ns) {
 void Subsystem::stop() {
   Impl& m = *impl_;
   if (m.stopped || !m.table) return;
-  m.stopped = true;
   // The paper's two-step termination: every task off, then every task killed.
   for (std::size_t i = 0; i < m.tasks.size(); ++i)
     if (m.tasks[i]->state() == TaskState::kOn) (void)m.signal(i, Signal::kOff);
   for (std::size_t i = 0; i < m.tasks.size(); ++i)
     if (m.tasks[i]->state() != TaskState::kNotCreated) (void)m.signal(i, Signal::kKill);
-  m.real_exec.reset();
+  m.stopped_at_ns = m.now();
+  m.stopped = true;
+  m.real_exec.reset();  // joins the threads
   m.virtual_exec.reset();
-  m.tasks.clear();
-  m.table.reset();  // unlinks the shared memory
+  m.collect_events();   // what off and kill reported stays readable, as do the tasks' figures
+  m.table.reset();      // unlinks the shared memory
 }
 
 std::int64_t Subsystem::now_ns() const { return impl_->now(); }
 ClockKind Subsystem::clock() const { return impl_->options.clock; }
 const SubsystemSpec& Subsystem::spec() const { return impl_->spec; }
 const ResolvedSubsystem& Subsystem::resolved() const { return impl_->resolution.subsystem; }
-GlobalTable& Subsystem::table() { return *impl_->table; }
+GlobalTable& Subsystem::table() {
+  assert(impl_->table && "table() after stop()");
+  return *impl_->table;
+}
 
 Result<std::vector<double>> Subsystem::get(std::string_view variable) const {
   const Impl& m = *impl_;
+  if (m.stopped) return make_error(Errc::kState, "the subsystem is stopped");
   const auto v = m.table->find(variable);
   if (!v) return make_error(Errc::kNotFound, fmt::format("no state variable named '{}'", variable));
   std::vector<std::byte> bytes(m.table->shape(*v).bytes());
@@ -180,6 +209,7 @@ Result<std::vector<double>> Subsystem::get(std::string_view variable) const {
 
 Result<void> Subsystem::set(std::string_view variable, const std::vector<double>& values) {
   Impl& m = *impl_;
+  if (m.stopped) return make_error(Errc::kState, "the subsystem is stopped");
   const auto v = m.table->find(variable);
   if (!v) return make_error(Errc::kNotFound, fmt::format("no state variable named '{}'", variable));
   for (const auto& [name, value] : m.spec.constants)
@@ -197,7 +227,9 @@ Result<void> Subsystem::set(std::string_view variable, const std::vector<double>
 }
 
 std::vector<TaskSnapshot> Subsystem::snapshot() const {
-  const Impl& m = *impl_;
+  Impl& m = *impl_;
+  m.collect_events();  // so that last_error is current whether or not anyone drains events
+  std::lock_guard<std::mutex> lock(m.events_mutex);
   std::vector<TaskSnapshot> out;
   for (std::size_t i = 0; i < m.tasks.size(); ++i) {
     const Task& t = *m.tasks[i];
@@ -209,15 +241,10 @@ std::vector<TaskSnapshot> Subsystem::snapshot() const {
 
 std::vector<Event> Subsystem::drain_events() {
   Impl& m = *impl_;
-  std::vector<Event> out;
-  RtEvent e;
-  for (std::size_t i = 0; i < m.tasks.size(); ++i) {
-    while (m.tasks[i]->events().pop(e)) {
-      out.push_back(Event{e.time_ns, m.tasks[i]->name(), e.text.data()});
-      if (std::strstr(e.text.data(), "ERROR") != nullptr || std::strstr(e.text.data(), "failed") != nullptr)
-        m.last_error[i] = e.text.data();
-    }
-  }
+  m.collect_events();
+  std::lock_guard<std::mutex> lock(m.events_mutex);
+  std::vector<Event> out = std::move(m.pending);
+  m.pending.clear();
   std::stable_sort(out.begin(), out.end(), [](const Event& a, const Event& b) { return a.time_ns < b.time_ns; });
   return out;
 }

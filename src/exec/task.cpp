@@ -61,8 +61,7 @@ Status Task::call(Hook hook) noexcept {
 }
 
 bool Task::recover(Hook hook, Status failure, std::int64_t now_ns) noexcept {
-  events_.push(now_ns, hook_name(static_cast<std::uint8_t>(hook)), " failed: ");
-  events_.push(now_ns, "  ", failure.reason());
+  events_.push(now_ns, hook_name(static_cast<std::uint8_t>(hook)), " failed: ", failure.reason());
   const Status handled = call(Hook::kError);
   if (handled.is_ok()) {
     events_.push(now_ns, "error() recovered", nullptr);

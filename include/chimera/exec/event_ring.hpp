@@ -21,9 +21,9 @@ class EventRing {
   static_assert((N & (N - 1)) == 0, "N must be a power of two");
 
  public:
-  /// Appends "<a><b>" (either may be null); drops the event and counts it if the ring is full.
-  /// Real-time safe: no allocation, no lock, no formatting.
-  void push(std::int64_t time_ns, const char* a, const char* b = nullptr) noexcept {
+  /// Appends the concatenation "<a><b><c>" (any may be null) as one event; drops the event and
+  /// counts it if the ring is full. Real-time safe: no allocation, no lock, no formatting.
+  void push(std::int64_t time_ns, const char* a, const char* b = nullptr, const char* c = nullptr) noexcept {
     const std::uint64_t head = head_.load(std::memory_order_relaxed);  // only this thread writes head
     // acquire: the consumer's reads of the slot we are about to reuse happened before its tail store
     if (head - tail_.load(std::memory_order_acquire) >= N) {
@@ -33,7 +33,7 @@ class EventRing {
     RtEvent& e = slots_[head & (N - 1)];
     e.time_ns = time_ns;
     std::size_t n = 0;
-    for (const char* s : {a, b}) {
+    for (const char* s : {a, b, c}) {
       for (; s != nullptr && *s != '\0' && n + 1 < e.text.size(); ++s) e.text[n++] = *s;
     }
     e.text[n] = '\0';

@@ -68,7 +68,9 @@ class Subsystem {
   Result<void> signal(std::string_view task, Signal signal);
   /// Lets the subsystem run for `ns`: simulated time on the virtual clock, a sleep on the real one.
   void run_for(std::int64_t ns);
-  /// Off, then kill, every task; removes the shared memory. Idempotent.
+  /// Off, then kill, every task; removes the shared memory. Idempotent. Afterwards snapshot()
+  /// and drain_events() still answer (the run's figures and last events); signal, get and set
+  /// are refused, and table() must not be called.
   void stop();
 
   /// Time since start on the subsystem's clock.
@@ -83,6 +85,7 @@ class Subsystem {
   Result<std::vector<double>> get(std::string_view variable) const;
   Result<void> set(std::string_view variable, const std::vector<double>& values);
 
+  /// Every task's state and figures; last_error is current without draining events.
   [[nodiscard]] std::vector<TaskSnapshot> snapshot() const;
   /// Events since the last call (drained from the tasks' real-time rings).
   std::vector<Event> drain_events();

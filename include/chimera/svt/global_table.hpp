@@ -54,7 +54,9 @@ class GlobalTable {
   void write(VarIndex v, const void* src) noexcept;
   /// Copies the newest complete value into `dst` if it is newer than `seen` (a version returned
   /// by an earlier read, 0 at first). Never torn, never waits for a writer; if a writer laps the
-  /// reader on every bounded retry, reports kOld and leaves `dst` as it was. Real-time safe.
+  /// reader on every bounded retry, reports kOld (kNoData if `seen` is 0) and leaves `dst` as it
+  /// was. Variables over 8 KiB have no stack scratch here: on exhausted retries `dst` is zeroed
+  /// and kNoData reported (LocalTable has scratch and keeps the old copy). Real-time safe.
   ReadOutcome read(VarIndex v, void* dst, std::uint64_t seen) const noexcept;
   /// Completed writes of v so far (0: never written). Real-time safe.
   [[nodiscard]] std::uint64_t version(VarIndex v) const noexcept;
@@ -63,15 +65,22 @@ class GlobalTable {
   void set_illegal_configuration(bool raised) noexcept;
   [[nodiscard]] bool illegal_configuration() const noexcept;
 
-  /// A write split in two, so that tests can stop a writer in the middle of one. `write()` is
-  /// begin_write + store_words over all words + end_write.
+  /// A write split in three, so that tests can stop a writer in the middle of one. `write()` is
+  /// begin_write + store_bytes over all bytes + end_write. Bytes not stored between begin_write
+  /// and end_write hold what the slot held before (a write four back). Real-time safe.
   void begin_write(VarIndex v) noexcept;
   void store_bytes(VarIndex v, std::size_t byte_offset, const void* src, std::size_t bytes) noexcept;
   void end_write(VarIndex v) noexcept;
 
  private:
+  friend class LocalTable;  // reads through its own scratch buffer (read_via)
+
   GlobalTable() = default;
   void release() noexcept;
+  // The reader of the protocol. Loads the words into `scratch` (at least as many words as the
+  // payload) and copies to `dst` only once they are known to be whole; with no scratch it loads
+  // straight into `dst`, and then on exhausted retries zeros dst and reports kNoData.
+  ReadOutcome read_via(VarIndex v, void* dst, std::uint64_t seen, std::uint64_t* scratch) const noexcept;
 
   std::string shm_name_;
   std::byte* base_ = nullptr;  // start of the mapping; everything inside is found by offset

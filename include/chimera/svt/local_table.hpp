@@ -2,6 +2,7 @@
 // A task's local state variable table (paper 3.1): private copies of only the variables the task
 // uses, and the transfers between them and the global table.
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -45,9 +46,10 @@ class LocalTable {
   void push_out_vars() noexcept;
   void push_out_consts() noexcept;
 
-  /// Zeros every local copy and marks inputs kNoData: a task joining a configuration starts
-  /// fresh. Real-time safe.
-  void reset() noexcept;
+  /// Zeros the local copies of inputs and marks them kNoData, so that a task joining a
+  /// configuration reads everything anew. Outputs are the module's and keep their values.
+  /// Real-time safe.
+  void reset_inputs() noexcept;
 
   [[nodiscard]] std::span<const PortBinding> ports() const noexcept { return ports_; }
 
@@ -62,11 +64,17 @@ class LocalTable {
   LocalTable() = default;
   Result<const Slot*> find_slot(std::string_view port, bool want_input, ElemType type) const;
 
+  void pull(PortKind kind) noexcept;
+  void push(PortKind kind) noexcept;
+
   GlobalTable* global_ = nullptr;
   std::vector<PortBinding> ports_;
   std::vector<Slot> slots_;  // parallel to ports_
   std::vector<Freshness> freshness_;  // parallel to ports_
   std::vector<std::max_align_t> storage_;  // aligned for any element type
+  std::array<std::vector<std::uint32_t>, 4> by_kind_;  // indices into slots_, per PortKind: no test per cycle
+  std::vector<std::uint64_t> scratch_;  // read buffer as large as the largest input: a read that
+                                        // a writer laps leaves the local copy whole
 };
 
 }  // namespace chimera

@@ -229,5 +229,33 @@ TEST(TaskLifecycle, OperatorSetIsRefusedForAProducedVariable) {
   EXPECT_FALSE(s->set("count", {1.5}).ok()) << "not a whole number for i64";
 }
 
+TEST(TaskLifecycle, AFailureIsOneEventAndLastErrorIsCurrentWithoutDraining) {
+  auto s = make("{fail: cycle}");
+  s->run_for(2 * kMs);
+  for (const auto& t : s->snapshot()) {
+    if (t.name == "p") {
+      EXPECT_NE(t.last_error.find("probe failed on purpose"), std::string::npos) << t.last_error;
+    }
+  }
+  const auto events = s->drain_events();
+  ASSERT_EQ(events.size(), 2u);
+  EXPECT_EQ(events[0].text, "cycle failed: probe failed on purpose");
+  EXPECT_EQ(events[1].text, "ERROR: operator intervention required (clear): probe failed on purpose");
+}
+
+TEST(TaskLifecycle, AfterStopFiguresRemainAndCommandsAreRefused) {
+  auto s = make("{}");
+  s->run_for(5 * kMs);
+  s->stop();
+  const auto snap = s->snapshot();
+  ASSERT_EQ(snap.size(), 2u);
+  EXPECT_EQ(snap[0].stats.cycles, 5u);
+  EXPECT_EQ(snap[0].state, TaskState::kNotCreated);
+  EXPECT_FALSE(s->get("count").ok());
+  EXPECT_FALSE(s->set("count", {1}).ok());
+  EXPECT_FALSE(s->signal("p", Signal::kSpawn).ok());
+  EXPECT_EQ(s->now_ns(), 5 * kMs);
+}
+
 }  // namespace
 }  // namespace chimera

@@ -1,0 +1,110 @@
+// The chimera command: verify, run and inspect subsystems (contract section 2).
+
+#include <cstdio>
+#include <exception>
+#include <memory>
+#include <string>
+
+#include <CLI/CLI.hpp>
+#include <spdlog/cfg/env.h>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include "chimera/config/loader.hpp"
+#include "commands.hpp"
+#include "exit_codes.hpp"
+
+namespace {
+
+using chimera::cli::kExitInvalid;
+using chimera::cli::kExitOk;
+
+// Replies and tables go to stdout; diagnostics must never mix into them.
+void log_to_stderr() {
+  spdlog::set_default_logger(spdlog::stderr_color_mt("chimera"));
+  spdlog::set_pattern("chimera: %^%l%$: %v");
+  spdlog::cfg::load_env_levels();  // SPDLOG_LEVEL=debug for more
+}
+
+CLI::Validator duration_validator() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        auto ns = chimera::parse_duration_ns(text);
+        if (!ns) return ns.error().message;
+        if (*ns <= 0) return "the duration must be positive";
+        return {};
+      },
+      "DURATION");
+}
+
+int run_main(int argc, char** argv) {
+  log_to_stderr();
+
+  CLI::App app{"Dynamically reconfigurable real-time software from port-based objects.", "chimera"};
+  app.require_subcommand(1);
+
+  chimera::cli::VerifyArgs verify;
+  std::string verify_config;
+  auto* verify_cmd = app.add_subcommand("verify", "Check a subsystem file and every configuration (or one)");
+  verify_cmd->add_option("FILE", verify.file, "subsystem file (YAML)")->required();
+  auto* verify_config_opt = verify_cmd->add_option("--config", verify_config, "check only this configuration");
+
+  chimera::cli::RunArgs run;
+  std::string run_config;
+  std::string run_for;
+  std::string run_clock = "real";
+  std::string run_stats;
+  auto* run_cmd = app.add_subcommand("run", "Run a subsystem; a shell on a terminal, commands from stdin otherwise");
+  run_cmd->add_option("FILE", run.file, "subsystem file (YAML)")->required();
+  auto* run_config_opt =
+      run_cmd->add_option("--config", run_config, "configuration to start (default: the file's start)");
+  auto* run_for_opt =
+      run_cmd->add_option("--for", run_for, "stop after this long (e.g. 2s)")->check(duration_validator());
+  run_cmd->add_option("--clock", run_clock, "real (wall clock) or virtual (simulated, deterministic)")
+      ->check(CLI::IsMember({"real", "virtual"}))
+      ->capture_default_str();
+  auto* run_stats_opt = run_cmd->add_option("--stats-json", run_stats, "write per-task timing figures here at exit");
+
+  chimera::cli::ModulesArgs modules;
+  std::string modules_name;
+  auto* modules_cmd = app.add_subcommand("modules", "List the module library, or one module's ports and parameters");
+  auto* modules_name_opt = modules_cmd->add_option("NAME", modules_name, "a module type");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // Help is a success; every other problem with the command line is exit 2, not CLI11's codes.
+    const int code = app.exit(e);
+    return code == 0 ? kExitOk : kExitInvalid;
+  }
+
+  if (verify_cmd->parsed()) {
+    if (verify_config_opt->count() > 0) verify.config = verify_config;
+    return chimera::cli::verify_command(verify);
+  }
+  if (run_cmd->parsed()) {
+    if (run_config_opt->count() > 0) run.config = run_config;
+    if (run_for_opt->count() > 0) run.for_ns = *chimera::parse_duration_ns(run_for);
+    if (run_stats_opt->count() > 0) run.stats_json = run_stats;
+    run.clock = run_clock == "virtual" ? chimera::ClockKind::kVirtual : chimera::ClockKind::kReal;
+    return chimera::cli::run_command(run);
+  }
+  if (modules_name_opt->count() > 0) modules.name = modules_name;
+  return chimera::cli::modules_command(modules);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // Every expected failure is a message and an exit code; this is the last guard against a crash.
+  try {
+    return run_main(argc, argv);
+  } catch (const std::exception& e) {
+    std::fputs("chimera: internal error: ", stderr);
+    std::fputs(e.what(), stderr);
+    std::fputs("\n", stderr);
+  } catch (...) {
+    std::fputs("chimera: internal error\n", stderr);
+  }
+  return kExitInvalid;
+}

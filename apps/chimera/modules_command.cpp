@@ -1,0 +1,120 @@
+// chimera modules [NAME]: the module library, or one module's ports, parameters and docs.
+
+#include <algorithm>
+#include <cstdio>
+#include <string>
+#include <string_view>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "chimera/control/text_table.hpp"
+#include "chimera/module/registry.hpp"
+#include "commands.hpp"
+#include "exit_codes.hpp"
+
+namespace chimera::cli {
+
+namespace {
+
+using Align = TextTable::Align;
+
+constexpr std::size_t kTextWidth = 100;
+
+// Module docs are written as long paragraphs; wrap them for a terminal, keeping their newlines.
+std::string wrap(std::string_view text, std::size_t width) {
+  std::string out;
+  std::size_t column = 0;
+  std::size_t i = 0;
+  while (i < text.size()) {
+    if (text[i] == '\n') {
+      out += '\n';
+      column = 0;
+      ++i;
+      continue;
+    }
+    if (text[i] == ' ') {
+      ++i;
+      continue;
+    }
+    const std::size_t end = std::min(text.find_first_of(" \n", i), text.size());
+    const std::string_view word = text.substr(i, end - i);
+    if (column > 0 && column + 1 + word.size() > width) {
+      out += '\n';
+      column = 0;
+    } else if (column > 0) {
+      out += ' ';
+      ++column;
+    }
+    out += word;
+    column += word.size();
+    i = end;
+  }
+  return out;
+}
+
+void print_list(const Registry& registry) {
+  TextTable table({{"module", Align::kLeft}, {"summary", Align::kLeft}});
+  for (const ModuleInfo* m : registry.list()) table.add_row({m->name, m->summary});
+  fmt::print("{}", table.render());
+}
+
+void print_module(const ModuleInfo& m) {
+  // Ports may depend on parameters; the defaults show the usual shape (sizes stay symbolic).
+  const Declarations decls = m.declarations(Params{});
+
+  fmt::print("{}: {}\n", m.name, m.summary);
+  if (!m.doc.empty()) fmt::print("\n{}\n", wrap(m.doc, kTextWidth));
+  if (!decls.resource().empty()) fmt::print("\nresource: {}\n", decls.resource());
+
+  fmt::print("\nports:\n");
+  if (decls.ports().empty()) {
+    fmt::print("  (none)\n");
+  } else {
+    TextTable ports({{"  kind", Align::kLeft},
+                     {"name", Align::kLeft},
+                     {"type", Align::kLeft},
+                     {"size", Align::kLeft},
+                     {"doc", Align::kLeft}});
+    for (const auto& p : decls.ports()) {
+      std::string size = to_string(p.dim);
+      if (!p.value.empty()) size += fmt::format(" = [{}]", fmt::join(p.value, ", "));
+      ports.add_row({fmt::format("  {}", port_kind_name(p.kind)), p.name, std::string(elem_name(p.type)), size, p.doc});
+    }
+    fmt::print("{}", ports.render());
+  }
+
+  fmt::print("\nparams:\n");
+  if (decls.params().empty()) {
+    fmt::print("  (none)\n");
+  } else {
+    TextTable params({{"  name", Align::kLeft},
+                      {"type", Align::kLeft},
+                      {"default", Align::kLeft},
+                      {"unit", Align::kLeft},
+                      {"doc", Align::kLeft}});
+    for (const auto& p : decls.params())
+      params.add_row({fmt::format("  {}", p.name), std::string(param_type_name(p.type)), to_string(p.default_value),
+                      p.unit, p.doc});
+    fmt::print("{}", params.render());
+  }
+}
+
+}  // namespace
+
+int modules_command(const ModulesArgs& args) {
+  const Registry& registry = Registry::global();
+  if (!args.name) {
+    print_list(registry);
+    return kExitOk;
+  }
+  const ModuleInfo* module = registry.find(*args.name);
+  if (module == nullptr) {
+    fmt::print(stderr, "unknown module '{}' (chimera modules lists them)\n", *args.name);
+    return kExitInvalid;
+  }
+  print_module(*module);
+  return kExitOk;
+}
+
+}  // namespace chimera::cli

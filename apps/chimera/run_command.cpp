@@ -1,0 +1,206 @@
+// chimera run FILE [--config NAME] [--for DURATION] [--clock real|virtual] [--stats-json FILE]:
+// starts the subsystem, takes commands from a shell or a script on stdin, stops it cleanly.
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <string_view>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "chimera/config/loader.hpp"
+#include "chimera/control/control.hpp"
+#include "chimera/control/stats_json.hpp"
+#include "chimera/control/timing_table.hpp"
+#include "chimera/exec/subsystem.hpp"
+#include "chimera/module/registry.hpp"
+#include "commands.hpp"
+#include "exit_codes.hpp"
+#include "line_reader.hpp"
+#include "stop_request.hpp"
+
+namespace chimera::cli {
+
+namespace {
+
+// How often the loop looks at signals, events and --for while it waits, in both clocks' time.
+constexpr std::int64_t kStepNs = 50'000'000;
+constexpr int kPollMs = 50;
+constexpr std::string_view kPrompt = "chimera> ";
+
+// The number of dynamic reconfigurations; `switch` comes with a later issue.
+constexpr std::uint64_t kSwitches = 0;
+
+void out(std::string_view text) {
+  std::fwrite(text.data(), 1, text.size(), stdout);
+  std::fflush(stdout);  // replies must reach a script reading the pipe as they happen
+}
+
+// Refuses a --stats-json path that cannot be written before anything starts, rather than
+// losing a whole run's figures at the end.
+Result<void> check_writable(const std::string& path) {
+  const bool existed = std::filesystem::exists(path);
+  {
+    std::ofstream probe(path, std::ios::app);
+    if (!probe) return make_error(Errc::kInvalidInput, fmt::format("--stats-json: cannot write '{}'", path));
+  }
+  std::error_code ignored;
+  if (!existed) std::filesystem::remove(path, ignored);
+  return {};
+}
+
+/// The loop between start and stop: commands in, replies and events out, time kept.
+class Session {
+ public:
+  Session(Subsystem& subsystem, const RunArgs& args, bool interactive)
+      : subsystem_(subsystem), control_(subsystem), args_(args), interactive_(interactive) {}
+
+  void run() {
+    LineReader reader(STDIN_FILENO);
+    bool input_open = true;
+    bool prompt_shown = false;
+    std::string line;
+    while (!should_end()) {
+      print_events(prompt_shown);
+      if (!input_open) {
+        run_on();
+        continue;
+      }
+      if (interactive_ && !prompt_shown) {
+        out(kPrompt);
+        prompt_shown = true;
+      }
+      switch (reader.next(line, kPollMs)) {
+        case LineReader::Status::kTimeout: break;
+        case LineReader::Status::kEnd:
+          input_open = false;
+          if (prompt_shown) out("\n");
+          prompt_shown = false;
+          // On a terminal Ctrl-D might be taken for quit; say what happens instead.
+          if (interactive_)
+            out(args_.for_ns ? "end of input: running on until --for has passed (Ctrl-C stops now)\n"
+                             : "end of input: running on until Ctrl-C\n");
+          break;
+        case LineReader::Status::kLine: {
+          prompt_shown = false;
+          const Reply reply = control_.execute_line(line);
+          out(reply.text);
+          if (reply.quit) return;
+          if (reply.wait_ns > 0) advance(reply.wait_ns);
+          break;
+        }
+      }
+    }
+    if (prompt_shown) out("\n");
+  }
+
+ private:
+  [[nodiscard]] bool time_up() const { return args_.for_ns && subsystem_.now_ns() >= *args_.for_ns; }
+  [[nodiscard]] bool should_end() const { return stop_requested() || time_up(); }
+
+  void print_events(bool& prompt_shown) {
+    const std::string events = control_.drain_events();
+    if (events.empty()) return;
+    // Keep the operator's prompt usable: events go on their own lines, then the prompt again.
+    if (prompt_shown) out("\n");
+    out(events);
+    prompt_shown = false;
+  }
+
+  // Lets the subsystem run for `ns` (capped by --for) in small steps, so that a signal or the
+  // end of --for is noticed within a step on either clock.
+  void advance(std::int64_t ns) {
+    const std::int64_t until = subsystem_.now_ns() + ns;
+    bool prompt_shown = false;
+    while (!should_end()) {
+      std::int64_t left = until - subsystem_.now_ns();
+      if (args_.for_ns) left = std::min(left, *args_.for_ns - subsystem_.now_ns());
+      if (left <= 0) break;
+      subsystem_.run_for(std::min(left, kStepNs));
+      print_events(prompt_shown);
+    }
+  }
+
+  // End of input: run on until --for has passed, or without --for until a signal.
+  void run_on() {
+    if (args_.for_ns)
+      advance(*args_.for_ns - subsystem_.now_ns());
+    else
+      advance(kStepNs);
+  }
+
+  Subsystem& subsystem_;
+  Control control_;
+  const RunArgs& args_;
+  bool interactive_;
+};
+
+}  // namespace
+
+int run_command(const RunArgs& args) {
+  const Registry& registry = Registry::global();
+  auto spec = load_subsystem_file(args.file, registry);
+  if (!spec) {
+    fmt::print(stderr, "{}\n", spec.error().message);
+    return kExitInvalid;
+  }
+  if (args.config && spec->find_configuration(*args.config) == nullptr) {
+    fmt::print(stderr, "{}: unknown configuration '{}'\n", args.file, *args.config);
+    return kExitInvalid;
+  }
+  if (args.stats_json) {
+    if (auto writable = check_writable(*args.stats_json); !writable) {
+      fmt::print(stderr, "{}\n", writable.error().message);
+      return kExitInvalid;
+    }
+  }
+
+  RunOptions options;
+  options.clock = args.clock;
+  options.configuration = args.config;
+  auto created = Subsystem::create(*spec, registry, options);
+  if (!created) {
+    fmt::print(stderr, "{}\n", created.error().message);
+    return kExitInvalid;
+  }
+  Subsystem& subsystem = **created;
+
+  install_stop_handlers();
+  if (auto started = subsystem.start(); !started) {
+    fmt::print(stderr, "{}\n", started.error().message);
+    subsystem.stop();  // start() already undid its work; this also removes the shared memory
+    return kExitInvalid;
+  }
+
+  const bool interactive = ::isatty(STDIN_FILENO) == 1;
+  if (interactive)
+    out(fmt::format("subsystem '{}' running configuration '{}' on the {} clock; type help for commands\n", spec->name,
+                    args.config.value_or(spec->start), args.clock == ClockKind::kVirtual ? "virtual" : "real"));
+
+  Session session(subsystem, args, interactive);
+  session.run();
+
+  // The figures as they stood while the tasks ran; stopping turns every task NOT-CREATED.
+  const auto tasks = subsystem.snapshot();
+  subsystem.stop();
+  Control control(subsystem);
+  out(control.drain_events());
+  out(timing_table(tasks));
+
+  int code = subsystem.hard_task_failed() ? kExitFailed : kExitOk;
+  if (args.stats_json) {
+    if (auto written = write_stats_json(*args.stats_json, tasks, args.clock, kSwitches); !written) {
+      fmt::print(stderr, "{}\n", written.error().message);
+      code = std::max(code, kExitFailed);
+    }
+  }
+  spdlog::debug("run ended with exit code {}", code);
+  return code;
+}
+
+}  // namespace chimera::cli

@@ -1,0 +1,57 @@
+// chimera verify FILE [--config NAME]: rules 1 to 3 for every configuration (or one).
+
+#include <cstdio>
+#include <set>
+#include <string>
+
+#include <fmt/format.h>
+
+#include "chimera/config/loader.hpp"
+#include "chimera/config/verify.hpp"
+#include "chimera/module/registry.hpp"
+#include "commands.hpp"
+#include "exit_codes.hpp"
+
+namespace chimera::cli {
+
+int verify_command(const VerifyArgs& args) {
+  const Registry& registry = Registry::global();
+  auto spec = load_subsystem_file(args.file, registry);
+  if (!spec) {
+    fmt::print(stderr, "{}\n", spec.error().message);
+    return kExitInvalid;
+  }
+  if (args.config && spec->find_configuration(*args.config) == nullptr) {
+    fmt::print(stderr, "{}: unknown configuration '{}'\n", args.file, *args.config);
+    return kExitInvalid;
+  }
+
+  const Resolution resolution = resolve_subsystem(*spec, registry);
+  const auto violations = verify_subsystem(resolution, args.config);
+  const std::size_t checked = args.config ? 1 : spec->configurations.size();
+
+  std::set<std::string> illegal;
+  bool file_wide = false;
+  for (const auto& v : violations) {
+    fmt::print("{}: {}\n", args.file, v.message);
+    if (v.configuration.empty())
+      file_wide = true;
+    else
+      illegal.insert(v.configuration);
+  }
+
+  if (violations.empty()) {
+    if (args.config)
+      fmt::print("{}: configuration '{}' legal\n", args.file, *args.config);
+    else
+      fmt::print("{}: {} configuration{} legal\n", args.file, checked, checked == 1 ? "" : "s");
+    return kExitOk;
+  }
+  // File-wide violations (configuration "") make every configuration unusable.
+  const std::size_t bad = file_wide ? checked : illegal.size();
+  fmt::print("{}: {} of {} configuration{} illegal, {} violation{}\n", args.file, bad, checked, checked == 1 ? "" : "s",
+             violations.size(), violations.size() == 1 ? "" : "s");
+  return kExitFailed;
+}
+
+}  // namespace chimera::cli

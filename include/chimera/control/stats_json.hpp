@@ -1,0 +1,23 @@
+#pragma once
+// The machine-readable counterpart of the timing table: what `chimera run --stats-json FILE`
+// writes at exit (contract section 2).
+
+#include <cstdint>
+#include <span>
+#include <string>
+
+#include "chimera/core/result.hpp"
+#include "chimera/exec/subsystem.hpp"
+
+namespace chimera {
+
+/// {"clock": "real"|"virtual", "switches": N, "tasks": {"<task>": {"module", "state",
+/// "period_ns", "cycles", "missed", "exec_ns": {"mean", "max"}, "latency_ns": {"p50", "p99",
+/// "max"}}}}, tasks in the order given. Not real-time safe.
+std::string stats_json(std::span<const TaskSnapshot> tasks, ClockKind clock, std::uint64_t switches);
+
+/// Writes stats_json() to `path`; an unwritable path is an Errc::kSystem error naming it.
+Result<void> write_stats_json(const std::string& path, std::span<const TaskSnapshot> tasks, ClockKind clock,
+                              std::uint64_t switches);
+
+}  // namespace chimera

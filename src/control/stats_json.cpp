@@ -1,0 +1,47 @@
+#include "chimera/control/stats_json.hpp"
+
+#include <cerrno>
+#include <fstream>
+#include <system_error>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+namespace chimera {
+
+std::string stats_json(std::span<const TaskSnapshot> tasks, ClockKind clock, std::uint64_t switches) {
+  // ordered_json keeps the tasks in file order, which is how people read them.
+  using Json = nlohmann::ordered_json;
+  Json per_task = Json::object();
+  for (const auto& t : tasks) {
+    const auto& s = t.stats;
+    per_task[t.name] = Json{
+        {"module", t.module},
+        {"state", std::string(state_name(t.state))},
+        {"period_ns", t.period_ns},
+        {"cycles", s.cycles},
+        {"missed", s.missed},
+        {"exec_ns", Json{{"mean", s.exec_mean_ns}, {"max", s.exec_max_ns}}},
+        {"latency_ns", Json{{"p50", s.latency_p50_ns}, {"p99", s.latency_p99_ns}, {"max", s.latency_max_ns}}},
+    };
+  }
+  const Json doc{
+      {"clock", clock == ClockKind::kVirtual ? "virtual" : "real"},
+      {"switches", switches},
+      {"tasks", std::move(per_task)},
+  };
+  return doc.dump(2) + "\n";
+}
+
+Result<void> write_stats_json(const std::string& path, std::span<const TaskSnapshot> tasks, ClockKind clock,
+                              std::uint64_t switches) {
+  std::ofstream out(path, std::ios::trunc);
+  if (!out)
+    return make_error(Errc::kSystem, fmt::format("{}: cannot write: {}", path, std::generic_category().message(errno)));
+  out << stats_json(tasks, clock, switches);
+  out.close();
+  if (!out) return make_error(Errc::kSystem, fmt::format("{}: write failed", path));
+  return {};
+}
+
+}  // namespace chimera

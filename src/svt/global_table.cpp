@@ -1,0 +1,343 @@
+// The global table's lifetime: creating, replacing, attaching to and removing its POSIX shared
+// memory region, and the directory lookups. The protocol is in global_table_protocol.cpp.
+
+#include "chimera/svt/global_table.hpp"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <chrono>
+#include <cstring>
+#include <limits>
+#include <new>
+#include <set>
+#include <system_error>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "svt/shm_layout.hpp"
+
+namespace chimera {
+
+namespace {
+
+using svt_detail::DirEntry;
+using svt_detail::Header;
+using svt_detail::object_at;
+using Word = std::atomic_ref<std::uint64_t>;
+
+/// Largest payload of one variable; keeps byte counts in 32 bits everywhere.
+constexpr std::uint64_t kMaxVarBytes = std::uint64_t{1} << 28;
+/// How long create() waits for a region that exists but has no owner pid yet (its creator is
+/// between shm_open and its first store) before calling it stale.
+constexpr auto kOwnerWait = std::chrono::milliseconds(200);
+
+Error sys_error(std::string_view what, const std::string& shm) {
+  return make_error(Errc::kSystem, fmt::format("{}({}) failed: {}", what, shm,
+                                               std::error_code(errno, std::generic_category()).message()));
+}
+
+/// Closes a descriptor on every path out of a function.
+class FdGuard {
+ public:
+  explicit FdGuard(int fd) : fd_(fd) {}
+  FdGuard(const FdGuard&) = delete;
+  FdGuard& operator=(const FdGuard&) = delete;
+  ~FdGuard() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+
+ private:
+  int fd_;
+};
+
+Result<void> check_subsystem_name(std::string_view name) {
+  if (name.empty() || name.size() > 200) {
+    return make_error(Errc::kInvalidInput, fmt::format("subsystem name '{}' must have 1 to 200 characters", name));
+  }
+  for (const char c : name) {
+    const bool ok =
+        (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-' || c == '.';
+    if (!ok) {
+      return make_error(Errc::kInvalidInput,
+                        fmt::format("subsystem name '{}' may hold only letters, digits, '_', '-' and '.'", name));
+    }
+  }
+  return {};
+}
+
+bool process_alive(std::uint64_t pid) {
+  if (pid == 0 || pid > static_cast<std::uint64_t>(std::numeric_limits<pid_t>::max())) return false;
+  // EPERM means it exists but belongs to someone else: alive all the same.
+  return ::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH;
+}
+
+/// What create() found under a name that already exists.
+struct Existing {
+  enum class Kind { kGone, kStale, kLive } kind;
+  std::uint64_t pid = 0;
+};
+
+Result<Existing> inspect_existing(const std::string& shm) {
+  const auto deadline = std::chrono::steady_clock::now() + kOwnerWait;
+  for (;;) {
+    const int fd = ::shm_open(shm.c_str(), O_RDONLY, 0);
+    if (fd < 0) {
+      if (errno == ENOENT) return Existing{Existing::Kind::kGone};
+      return sys_error("shm_open", shm);
+    }
+    FdGuard guard(fd);
+    struct stat st {};
+    if (::fstat(fd, &st) != 0) return sys_error("fstat", shm);
+    std::uint64_t pid = 0;
+    if (static_cast<std::uint64_t>(st.st_size) >= sizeof(Header)) {
+      void* p = ::mmap(nullptr, sizeof(Header), PROT_READ, MAP_SHARED, fd, 0);
+      if (p == MAP_FAILED) return sys_error("mmap", shm);
+      auto* header = object_at<Header>(static_cast<std::byte*>(p), 0);
+      // Relaxed: the pid is a value on its own; nothing else of the region is read here.
+      pid = Word(header->owner_pid).load(std::memory_order_relaxed);
+      ::munmap(p, sizeof(Header));
+    }
+    if (pid != 0) return Existing{process_alive(pid) ? Existing::Kind::kLive : Existing::Kind::kStale, pid};
+    // No pid yet: a creator may be between shm_open and its first store. Give it a moment.
+    if (std::chrono::steady_clock::now() >= deadline) return Existing{Existing::Kind::kStale};
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+}
+
+Result<void> check_vars(std::span<const VarSpec> vars) {
+  if (vars.size() > std::numeric_limits<std::uint32_t>::max()) {
+    return make_error(Errc::kInvalidInput, "too many state variables");
+  }
+  std::set<std::string_view> names;
+  for (const VarSpec& var : vars) {
+    if (var.name.empty() || var.name.size() >= svt_detail::kNameCapacity) {
+      return make_error(Errc::kInvalidInput, fmt::format("state variable name '{}' must have 1 to {} characters",
+                                                         var.name, svt_detail::kNameCapacity - 1));
+    }
+    if (!names.insert(var.name).second) {
+      return make_error(Errc::kInvalidInput, fmt::format("state variable '{}' is declared twice", var.name));
+    }
+    if (var.shape.count == 0 || elem_size(var.shape.type) == 0) {
+      return make_error(Errc::kInvalidInput, fmt::format("state variable '{}' has no elements", var.name));
+    }
+    if (var.shape.bytes() > kMaxVarBytes) {
+      return make_error(Errc::kInvalidInput, fmt::format("state variable '{}' ({}) is larger than {} bytes", var.name,
+                                                         to_string(var.shape), kMaxVarBytes));
+    }
+  }
+  return {};
+}
+
+/// Checks that an attached region's directory stays inside it, so a damaged or foreign region
+/// is refused here rather than crashing a task later.
+Result<void> check_layout(std::byte* base, std::uint64_t mapped, const std::string& shm) {
+  const auto* header = object_at<Header>(base, 0);
+  auto bad = [&](std::string_view why) {
+    return make_error(Errc::kSystem, fmt::format("shared memory {} is damaged: {}", shm, why));
+  };
+  if (header->total_size > mapped) return bad("it is smaller than its header says");
+  const std::uint64_t dir_end = header->directory_offset + std::uint64_t{header->var_count} * sizeof(DirEntry);
+  if (header->directory_offset < sizeof(Header) || dir_end > header->total_size) return bad("directory out of range");
+  for (std::uint32_t v = 0; v < header->var_count; ++v) {
+    const DirEntry* e = svt_detail::dir_entry(base, v);
+    const std::uint64_t bytes = elem_size(static_cast<ElemType>(e->elem_type)) * std::uint64_t{e->count};
+    if (std::memchr(e->name.data(), '\0', e->name.size()) == nullptr) return bad("a name is not terminated");
+    if (e->elem_type > static_cast<std::uint8_t>(ElemType::kU8) || e->count == 0 || bytes > kMaxVarBytes ||
+        e->payload_words != svt_detail::payload_words(bytes)) {
+      return bad(fmt::format("variable {} has an impossible shape", v));
+    }
+    if (e->block_offset % svt_detail::kCacheLine != 0 || e->block_offset < dir_end ||
+        e->block_offset + svt_detail::block_bytes(e->payload_words) > header->total_size) {
+      return bad(fmt::format("variable {} lies outside the region", v));
+    }
+  }
+  return {};
+}
+
+}  // namespace
+
+Result<GlobalTable> GlobalTable::create(std::string_view subsystem_name, std::span<const VarSpec> vars) {
+  if (auto r = check_subsystem_name(subsystem_name); !r) return r.error();
+  if (auto r = check_vars(vars); !r) return r.error();
+  const std::string shm = fmt::format("/chimera_{}", subsystem_name);
+
+  // Layout first: the directory right after the header, then one 64-aligned block per variable.
+  const std::uint64_t dir_end = svt_detail::directory_offset() + vars.size() * sizeof(DirEntry);
+  std::uint64_t total = svt_detail::round_up(dir_end, svt_detail::kCacheLine);
+  std::vector<std::uint64_t> block_offsets;
+  block_offsets.reserve(vars.size());
+  for (const VarSpec& var : vars) {
+    block_offsets.push_back(total);
+    total += svt_detail::block_bytes(svt_detail::payload_words(var.shape.bytes()));
+  }
+
+  // O_EXCL: exactly one process owns a name. An existing region is refused if its owner lives,
+  // and replaced if it is dead. Three rounds cover a region removed or replaced meanwhile.
+  int fd = -1;
+  for (int round = 0; round < 3 && fd < 0; ++round) {
+    fd = ::shm_open(shm.c_str(), O_CREAT | O_EXCL | O_RDWR, 0600);
+    if (fd >= 0) break;
+    if (errno != EEXIST) return sys_error("shm_open", shm);
+    auto existing = inspect_existing(shm);
+    if (!existing) return existing.error();
+    if (existing->kind == Existing::Kind::kLive) {
+      return make_error(Errc::kSystem, fmt::format("subsystem '{}' is already running (pid {}); shared memory {}",
+                                                   subsystem_name, existing->pid, shm));
+    }
+    if (existing->kind == Existing::Kind::kStale && ::shm_unlink(shm.c_str()) != 0 && errno != ENOENT) {
+      return sys_error("shm_unlink of a stale", shm);
+    }
+  }
+  if (fd < 0) {
+    return make_error(Errc::kSystem, fmt::format("could not create shared memory {}: another process keeps "
+                                                 "creating it",
+                                                 shm));
+  }
+  FdGuard guard(fd);
+  auto fail = [&](std::string_view what) {
+    Error e = sys_error(what, shm);
+    ::shm_unlink(shm.c_str());
+    return e;
+  };
+  // shm_open applied the umask; state the mode outright.
+  if (::fchmod(fd, 0600) != 0) return fail("fchmod");
+  if (::ftruncate(fd, static_cast<off_t>(total)) != 0) return fail("ftruncate");
+  void* p = ::mmap(nullptr, total, PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
+  if (p == MAP_FAILED) return fail("mmap");
+
+  GlobalTable table;
+  table.shm_name_ = shm;
+  table.base_ = static_cast<std::byte*>(p);
+  table.mapped_bytes_ = total;
+  table.owner_ = true;
+
+  // ftruncate zero-filled the region: every version, seq and payload word starts at 0, and the
+  // placement news below default-initialise, leaving those zeros (a starter may be reading them).
+  auto* header = new (table.base_) Header;  // default-init: no store over the zeros
+  // Relaxed: a starter reads the pid alone (inspect_existing); it is stored first so that the
+  // window in which this region has no owner is as short as possible.
+  Word(header->owner_pid).store(static_cast<std::uint64_t>(::getpid()), std::memory_order_relaxed);
+  header->layout_version = svt_detail::kLayoutVersion;
+  header->var_count = static_cast<std::uint32_t>(vars.size());
+  header->directory_offset = svt_detail::directory_offset();
+  header->total_size = total;
+  for (std::size_t v = 0; v < vars.size(); ++v) {
+    auto* e = new (table.base_ + svt_detail::directory_offset() + v * sizeof(DirEntry)) DirEntry;
+    std::memcpy(e->name.data(), vars[v].name.data(), vars[v].name.size());
+    e->count = vars[v].shape.count;
+    e->elem_type = static_cast<std::uint8_t>(vars[v].shape.type);
+    e->payload_words = static_cast<std::uint32_t>(svt_detail::payload_words(vars[v].shape.bytes()));
+    e->block_offset = block_offsets[v];
+  }
+  // Release: a process that attaches and sees the magic (acquire) sees the whole layout above.
+  Word(header->magic).store(svt_detail::kMagic, std::memory_order_release);
+  return table;
+}
+
+Result<GlobalTable> GlobalTable::attach(std::string_view subsystem_name) {
+  if (auto r = check_subsystem_name(subsystem_name); !r) return r.error();
+  const std::string shm = fmt::format("/chimera_{}", subsystem_name);
+  const int fd = ::shm_open(shm.c_str(), O_RDWR, 0);
+  if (fd < 0) {
+    if (errno == ENOENT) {
+      return make_error(Errc::kNotFound,
+                        fmt::format("subsystem '{}' is not running (no shared memory {})", subsystem_name, shm));
+    }
+    return sys_error("shm_open", shm);
+  }
+  FdGuard guard(fd);
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) return sys_error("fstat", shm);
+  const auto size = static_cast<std::uint64_t>(st.st_size);
+  if (size < sizeof(Header)) {
+    return make_error(Errc::kSystem, fmt::format("shared memory {} is not a state variable table (or is "
+                                                 "still being created)",
+                                                 shm));
+  }
+  void* p = ::mmap(nullptr, size, PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
+  if (p == MAP_FAILED) return sys_error("mmap", shm);
+
+  GlobalTable table;  // unmaps on every error path below
+  table.shm_name_ = shm;
+  table.base_ = static_cast<std::byte*>(p);
+  table.mapped_bytes_ = size;
+  auto* header = object_at<Header>(table.base_, 0);
+  // Acquire: pairs with create()'s release store of the magic, so the layout is complete.
+  if (Word(header->magic).load(std::memory_order_acquire) != svt_detail::kMagic) {
+    return make_error(Errc::kSystem, fmt::format("shared memory {} is not a state variable table (or is "
+                                                 "still being created)",
+                                                 shm));
+  }
+  if (header->layout_version != svt_detail::kLayoutVersion) {
+    return make_error(Errc::kSystem, fmt::format("shared memory {} has layout version {}; this program "
+                                                 "understands version {}",
+                                                 shm, header->layout_version, svt_detail::kLayoutVersion));
+  }
+  if (auto r = check_layout(table.base_, size, shm); !r) return r.error();
+  return table;
+}
+
+GlobalTable::GlobalTable(GlobalTable&& other) noexcept
+    : shm_name_(std::move(other.shm_name_)),
+      base_(std::exchange(other.base_, nullptr)),
+      mapped_bytes_(std::exchange(other.mapped_bytes_, 0)),
+      owner_(std::exchange(other.owner_, false)) {}
+
+GlobalTable& GlobalTable::operator=(GlobalTable&& other) noexcept {
+  if (this != &other) {
+    release();
+    shm_name_ = std::move(other.shm_name_);
+    base_ = std::exchange(other.base_, nullptr);
+    mapped_bytes_ = std::exchange(other.mapped_bytes_, 0);
+    owner_ = std::exchange(other.owner_, false);
+  }
+  return *this;
+}
+
+GlobalTable::~GlobalTable() { release(); }
+
+void GlobalTable::release() noexcept {
+  if (base_ == nullptr) return;
+  // A child forked from the owner inherits this handle but must not remove the parent's region:
+  // only the process named in the header unlinks it.
+  auto* header = object_at<Header>(base_, 0);
+  // Relaxed: the pid was stored by this process (or before the magic we acquired in attach).
+  const bool creator_here =
+      Word(header->owner_pid).load(std::memory_order_relaxed) == static_cast<std::uint64_t>(::getpid());
+  ::munmap(base_, mapped_bytes_);
+  if (owner_ && creator_here) ::shm_unlink(shm_name_.c_str());
+  base_ = nullptr;
+  mapped_bytes_ = 0;
+  owner_ = false;
+}
+
+std::size_t GlobalTable::size() const noexcept { return mapped_bytes_; }
+
+std::optional<VarIndex> GlobalTable::find(std::string_view var_name) const {
+  const auto* header = object_at<Header>(base_, 0);
+  for (VarIndex v = 0; v < header->var_count; ++v) {
+    if (name(v) == var_name) return v;
+  }
+  return std::nullopt;
+}
+
+std::string_view GlobalTable::name(VarIndex v) const noexcept {
+  const DirEntry* e = svt_detail::dir_entry(base_, v);
+  return {e->name.data(), ::strnlen(e->name.data(), e->name.size())};
+}
+
+VarShape GlobalTable::shape(VarIndex v) const noexcept {
+  const DirEntry* e = svt_detail::dir_entry(base_, v);
+  return VarShape{static_cast<ElemType>(e->elem_type), e->count};
+}
+
+}  // namespace chimera

@@ -1,0 +1,228 @@
+// The chimera command as users script it (contract section 2): exit codes, messages, runs.
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "run_chimera.hpp"
+
+namespace chimera::test {
+namespace {
+
+const std::string kData = CLI_DATA_DIR;
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+class CliTest : public ::testing::Test {
+ protected:
+  Outcome chimera(const std::string& args, const std::string& input = {}, const std::string& prefix = {}) {
+    return run_chimera(dir_, args, input, prefix);
+  }
+  static std::string data(const std::string& name) { return quoted(kData + "/" + name); }
+  std::string copy(const std::string& name) { return quoted(private_copy(dir_, name)); }
+
+  TempDir dir_;
+};
+
+// The output travels with a wrong exit code: it says why.
+// NOLINTNEXTLINE(cppcoreguidelines-macro-usage): gtest reports the caller's line only from a macro
+#define EXPECT_EXIT_CODE(outcome, code) \
+  EXPECT_EQ((outcome).exit_code, code) << "stdout:\n" << (outcome).out << "stderr:\n" << (outcome).err
+
+TEST_F(CliTest, VerifyLegalFileExitsZero) {
+  const auto o = chimera("verify " + data("fig4.yaml"));
+  EXPECT_EXIT_CODE(o, 0);
+  EXPECT_TRUE(contains(o.out, "fig4.yaml: 1 configuration legal")) << o.out;
+}
+
+TEST_F(CliTest, VerifyIllegalFileExitsOneWithOneLinePerViolation) {
+  const auto o = chimera("verify " + data("illegal.yaml"));
+  EXPECT_EXIT_CODE(o, 1);
+  // pid reads theta_d and dtheta_d, which nothing produces in no_traj: two rule-2 lines.
+  int lines = 0;
+  for (const char* variable : {"theta_d", "dtheta_d"}) {
+    const auto line_start = o.out.find(std::string("rule 2: ") + variable);
+    ASSERT_NE(line_start, std::string::npos) << o.out;
+    const auto line = o.out.substr(o.out.rfind('\n', line_start) + 1);
+    EXPECT_TRUE(contains(line.substr(0, line.find('\n')), "pid")) << line;
+    ++lines;
+  }
+  EXPECT_EQ(lines, 2);
+  EXPECT_TRUE(contains(o.out, "no_traj")) << o.out;
+}
+
+TEST_F(CliTest, VerifyOneConfiguration) {
+  EXPECT_EXIT_CODE(chimera("verify " + data("illegal.yaml") + " --config full"), 0);
+  EXPECT_EXIT_CODE(chimera("verify " + data("illegal.yaml") + " --config no_traj"), 1);
+  const auto unknown = chimera("verify " + data("illegal.yaml") + " --config nosuch");
+  EXPECT_EXIT_CODE(unknown, 2);
+  EXPECT_TRUE(contains(unknown.err, "nosuch")) << unknown.err;
+}
+
+TEST_F(CliTest, VerifyBadFileNamesFileLineAndKey) {
+  auto o = chimera("verify " + data("bad_period.yaml"));
+  EXPECT_EXIT_CODE(o, 2);
+  EXPECT_TRUE(contains(o.err, "bad_period.yaml:8: tasks[1].period")) << o.err;
+  EXPECT_EQ(o.out, "");
+
+  o = chimera("verify " + data("unknown_key.yaml"));
+  EXPECT_EXIT_CODE(o, 2);
+  EXPECT_TRUE(contains(o.err, "unknown_key.yaml:5: tasks[0].perod")) << o.err;
+
+  o = chimera("verify " + data("no_such_file.yaml"));
+  EXPECT_EXIT_CODE(o, 2);
+  EXPECT_TRUE(contains(o.err, "no_such_file.yaml")) << o.err;
+}
+
+TEST_F(CliTest, ModulesListsThePaperModules) {
+  const auto o = chimera("modules");
+  EXPECT_EXIT_CODE(o, 0);
+  for (const char* name : {"joint_traj_gen", "pid_joint", "robot_torque"})
+    EXPECT_TRUE(contains(o.out, std::string("\n") + name + " ")) << name << "\n" << o.out;
+}
+
+TEST_F(CliTest, ModulesShowsOneModule) {
+  const auto o = chimera("modules pid_joint");
+  EXPECT_EXIT_CODE(o, 0);
+  for (const char* part :
+       {"pid_joint: ", "ports:", "in-const", "ndof", "in-var", "theta_d", "out-var", "tau_r", "params:", "kp"})
+    EXPECT_TRUE(contains(o.out, part)) << part << "\n" << o.out;
+}
+
+TEST_F(CliTest, ModulesUnknownNameExitsTwo) {
+  const auto o = chimera("modules nosuch");
+  EXPECT_EXIT_CODE(o, 2);
+  EXPECT_TRUE(contains(o.err, "nosuch")) << o.err;
+}
+
+TEST_F(CliTest, BadCommandLineExitsTwo) {
+  const std::vector<std::string> bad{"",
+                                     "frobnicate",
+                                     "verify",
+                                     "run",
+                                     "modules a b",
+                                     "run " + data("fig4.yaml") + " --clock sometimes",
+                                     "run " + data("fig4.yaml") + " --for 10",
+                                     "verify " + data("fig4.yaml") + " --bogus"};
+  for (const auto& args : bad) {
+    const auto o = chimera(args);
+    EXPECT_EXIT_CODE(o, 2);
+    EXPECT_FALSE(o.err.empty()) << args;
+  }
+  EXPECT_EXIT_CODE(chimera("--help"), 0);
+}
+
+TEST_F(CliTest, RunScriptedOnTheVirtualClock) {
+  const auto o = chimera("run " + copy("fig4.yaml") + " --clock virtual --for 2s",
+                         "status\n"
+                         "# a comment and a blank line\n"
+                         "\n"
+                         "get theta_m\n"
+                         "wait 1s\n"
+                         "stats\n"
+                         "quit\n"
+                         "status\n");
+  EXPECT_EXIT_CODE(o, 0);
+  EXPECT_TRUE(o.err.empty()) << o.err;
+  // status: a table, every task ON, nothing run yet
+  EXPECT_EQ(o.out.rfind("task ", 0), 0U) << o.out;
+  EXPECT_TRUE(contains(o.out, "pid    pid_joint       ON       1 ms       0       0\n")) << o.out;
+  EXPECT_TRUE(contains(o.out, "theta_m = [")) << o.out;
+  // stats after 1 s simulated: the timing table with 1000 cycles of the 1 ms tasks
+  EXPECT_TRUE(contains(o.out, "latency p99")) << o.out;
+  EXPECT_TRUE(contains(o.out, "  1000  ")) << o.out;
+  // quit stops at once: the `status` after it is never read, the final table still printed
+  EXPECT_EQ(o.out.find("task   module          state  period  cycles  missed\n", 1), std::string::npos) << o.out;
+}
+
+TEST_F(CliTest, RunRepliesToBadCommandsAndGoesOn) {
+  const auto o = chimera("run " + copy("fig4.yaml") + " --clock virtual --for 10ms",
+                         "bogus\non pid nosuch\nset theta_m 1 2 3 4 5 6\nswitch other\nget theta_d\n");
+  EXPECT_EXIT_CODE(o, 0);
+  EXPECT_TRUE(contains(o.out, "unknown command 'bogus' (try help)\n")) << o.out;
+  EXPECT_TRUE(contains(o.out, "unknown task 'nosuch'\n")) << o.out;
+  EXPECT_TRUE(contains(o.out, "theta_m is produced by task 'robot'")) << o.out;
+  EXPECT_TRUE(contains(o.out, "unknown command 'switch' (try help)\n")) << o.out;
+  EXPECT_TRUE(contains(o.out, "theta_d = [")) << o.out;
+}
+
+TEST_F(CliTest, RunWritesStatsJsonAndRunsOnUntilFor) {
+  const std::string json = dir_.file("stats.json");
+  const auto o = chimera("run " + copy("fig4.yaml") + " --clock virtual --for 2s --stats-json " + quoted(json),
+                         "status\nwait 1s\n");
+  EXPECT_EXIT_CODE(o, 0);
+  ASSERT_TRUE(std::filesystem::exists(json));
+  const auto doc = nlohmann::json::parse(read_text(json));
+  EXPECT_EQ(doc.at("clock"), "virtual");
+  EXPECT_EQ(doc.at("switches"), 0);
+  for (const char* task : {"traj", "pid", "robot"}) {
+    const auto& t = doc.at("tasks").at(task);
+    EXPECT_EQ(t.at("state"), "ON") << task;
+    for (const char* key : {"cycles", "missed"}) EXPECT_TRUE(t.at(key).is_number_unsigned()) << task << key;
+    for (const char* key : {"mean", "max"}) EXPECT_TRUE(t.at("exec_ns").at(key).is_number()) << task << key;
+    for (const char* key : {"p50", "p99", "max"}) EXPECT_TRUE(t.at("latency_ns").at(key).is_number()) << task << key;
+  }
+  // 2 s of simulated time at 1 ms, and 10 ms for the trajectory generator
+  EXPECT_NEAR(doc.at("tasks").at("pid").at("cycles").get<double>(), 2000, 2);
+  EXPECT_NEAR(doc.at("tasks").at("robot").at("cycles").get<double>(), 2000, 2);
+  EXPECT_NEAR(doc.at("tasks").at("traj").at("cycles").get<double>(), 200, 1);
+  // the timing table at the end says the same
+  EXPECT_TRUE(contains(o.out, "exec mean")) << o.out;
+}
+
+TEST_F(CliTest, RunIsDeterministicOnTheVirtualClock) {
+  const std::string script = "wait 500ms\nget theta_m\nget tau_r\n";
+  const auto first = chimera("run " + copy("fig4.yaml") + " --clock virtual --for 1s", script);
+  const auto second = chimera("run " + copy("fig4.yaml") + " --clock virtual --for 1s", script);
+  EXPECT_EXIT_CODE(first, 0);
+  auto values = [](const std::string& out) {
+    const auto begin = out.find("theta_m = ");
+    return begin == std::string::npos ? std::string() : out.substr(begin, out.find("task ", begin) - begin);
+  };
+  EXPECT_FALSE(values(first.out).empty()) << first.out;
+  EXPECT_EQ(values(first.out), values(second.out));
+}
+
+TEST_F(CliTest, RunInvalidFileOrConfigurationExitsTwo) {
+  auto o = chimera("run " + data("bad_period.yaml") + " --clock virtual --for 10ms");
+  EXPECT_EXIT_CODE(o, 2);
+  EXPECT_TRUE(contains(o.err, "bad_period.yaml:8: tasks[1].period")) << o.err;
+  EXPECT_EQ(o.out, "");
+
+  o = chimera("run " + copy("fig4.yaml") + " --clock virtual --for 10ms --config nosuch");
+  EXPECT_EXIT_CODE(o, 2);
+  EXPECT_TRUE(contains(o.err, "nosuch")) << o.err;
+
+  // An illegal start configuration is refused before anything starts.
+  o = chimera("run " + copy("illegal.yaml") + " --clock virtual --for 10ms --config no_traj");
+  EXPECT_EXIT_CODE(o, 2);
+  EXPECT_TRUE(contains(o.err, "rule 2")) << o.err;
+  EXPECT_EQ(o.out, "");
+
+  o = chimera("run " + copy("fig4.yaml") + " --clock virtual --for 10ms --stats-json /nonexistent-dir/s.json");
+  EXPECT_EXIT_CODE(o, 2);
+  EXPECT_TRUE(contains(o.err, "/nonexistent-dir/s.json")) << o.err;
+}
+
+TEST_F(CliTest, RunStopsCleanlyOnSigterm) {
+  // No --for and stdin at its end: only the signal ends the run.
+  const auto o = chimera("run " + copy("fig4.yaml") + " --clock virtual", "", "timeout --preserve-status -s TERM 1");
+  EXPECT_EXIT_CODE(o, 0);
+  EXPECT_TRUE(contains(o.out, "latency p99")) << o.out;
+}
+
+TEST_F(CliTest, RunOnTheRealClock) {
+  // Timing figures are for benchmarks; here only that the run starts, cycles and stops cleanly.
+  const std::string json = dir_.file("stats.json");
+  const auto o = chimera("run " + copy("fig4.yaml") + " --for 300ms --stats-json " + quoted(json), "status\n");
+  EXPECT_EXIT_CODE(o, 0);
+  const auto doc = nlohmann::json::parse(read_text(json));
+  EXPECT_EQ(doc.at("clock"), "real");
+  EXPECT_GT(doc.at("tasks").at("pid").at("cycles").get<int>(), 0);
+}
+
+}  // namespace
+}  // namespace chimera::test

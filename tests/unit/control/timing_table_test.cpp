@@ -1,0 +1,122 @@
+#include "chimera/control/timing_table.hpp"
+
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "chimera/control/stats_json.hpp"
+#include "chimera/control/text_table.hpp"
+
+namespace chimera {
+namespace {
+
+std::vector<TaskSnapshot> sample() {
+  TaskSnapshot pid;
+  pid.name = "pid";
+  pid.module = "pid_joint";
+  pid.state = TaskState::kOn;
+  pid.period_ns = 1'000'000;
+  pid.stats = {2000, 3, 12'345, 250'000, 800, 40'000, 1'500'000};
+  TaskSnapshot traj;
+  traj.name = "traj";
+  traj.module = "joint_traj_gen";
+  traj.state = TaskState::kNotCreated;
+  traj.period_ns = 10'000'000;
+  return {pid, traj};
+}
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> out;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) out.push_back(line);
+  return out;
+}
+
+TEST(FormatDuration, PicksTheUnitThatKeepsTheNumberShort) {
+  EXPECT_EQ(format_duration(0), "0 ns");
+  EXPECT_EQ(format_duration(850), "850 ns");
+  EXPECT_EQ(format_duration(12'345), "12.3 µs");
+  EXPECT_EQ(format_duration(999'949), "999.9 µs");
+  EXPECT_EQ(format_duration(1'250'000), "1.25 ms");
+  EXPECT_EQ(format_duration(2'000'000'000), "2.000 s");
+}
+
+TEST(FormatPeriod, ReadsAsTheFileWroteIt) {
+  EXPECT_EQ(format_period(0), "aperiodic");
+  EXPECT_EQ(format_period(1'000'000), "1 ms");
+  EXPECT_EQ(format_period(30'000'000), "30 ms");
+  EXPECT_EQ(format_period(250'000), "250 µs");
+  EXPECT_EQ(format_period(2'000'000'000), "2 s");
+  EXPECT_EQ(format_period(30'303'030), "30.303 ms");  // 33Hz
+  EXPECT_EQ(format_period(500), "500 ns");
+}
+
+TEST(TextTable, AlignsByCodePoints) {
+  TextTable t({{"a", TextTable::Align::kLeft}, {"b", TextTable::Align::kRight}});
+  t.add_row({"x", "1 µs"});
+  t.add_row({"long", "10 ms"});
+  EXPECT_EQ(t.render(),
+            "a         b\n"
+            "x      1 µs\n"
+            "long  10 ms\n");
+  EXPECT_EQ(display_width("µs"), 2U);
+}
+
+TEST(StatusTable, OneRowPerTask) {
+  const auto text = status_table(sample());
+  const auto lines = lines_of(text);
+  ASSERT_EQ(lines.size(), 3U);
+  EXPECT_EQ(lines[0], "task  module          state        period  cycles  missed");
+  EXPECT_EQ(lines[1], "pid   pid_joint       ON             1 ms    2000       3");
+  EXPECT_EQ(lines[2], "traj  joint_traj_gen  NOT-CREATED   10 ms       0       0");
+}
+
+TEST(StatusTable, ShowsTheLastErrorWhenThereIsOne) {
+  auto tasks = sample();
+  tasks[0].last_error = "ERROR: operator intervention required (clear): joint limit";
+  const auto text = status_table(tasks);
+  EXPECT_NE(lines_of(text)[0].find("last error"), std::string::npos);
+  EXPECT_NE(text.find("joint limit"), std::string::npos);
+}
+
+TEST(TimingTable, HumanUnitsAndDashesForTasksThatNeverRan) {
+  const auto lines = lines_of(timing_table(sample()));
+  ASSERT_EQ(lines.size(), 3U);
+  for (const char* header : {"task", "module", "state", "period", "cycles", "missed", "exec mean", "exec max",
+                             "latency p50", "latency p99", "latency max"})
+    EXPECT_NE(lines[0].find(header), std::string::npos) << header;
+  for (const char* figure : {"12.3 µs", "250.0 µs", "800 ns", "40.0 µs", "1.50 ms"})
+    EXPECT_NE(lines[1].find(figure), std::string::npos) << figure;
+  EXPECT_EQ(lines[2].substr(lines[2].size() - 1), "-");
+  // Every line has the same width: the columns line up.
+  EXPECT_EQ(display_width(lines[0]), display_width(lines[1]));
+}
+
+TEST(StatsJson, HasTheContractKeys) {
+  const auto doc = nlohmann::json::parse(stats_json(sample(), ClockKind::kVirtual, 0));
+  EXPECT_EQ(doc.at("clock"), "virtual");
+  EXPECT_EQ(doc.at("switches"), 0);
+  const auto& pid = doc.at("tasks").at("pid");
+  EXPECT_EQ(pid.at("state"), "ON");
+  EXPECT_EQ(pid.at("cycles"), 2000);
+  EXPECT_EQ(pid.at("missed"), 3);
+  EXPECT_EQ(pid.at("exec_ns").at("mean"), 12'345);
+  EXPECT_EQ(pid.at("exec_ns").at("max"), 250'000);
+  EXPECT_EQ(pid.at("latency_ns").at("p50"), 800);
+  EXPECT_EQ(pid.at("latency_ns").at("p99"), 40'000);
+  EXPECT_EQ(pid.at("latency_ns").at("max"), 1'500'000);
+  EXPECT_EQ(doc.at("tasks").at("traj").at("state"), "NOT-CREATED");
+  EXPECT_EQ(nlohmann::json::parse(stats_json({}, ClockKind::kReal, 0)).at("clock"), "real");
+}
+
+TEST(StatsJson, UnwritablePathIsAnError) {
+  auto r = write_stats_json("/nonexistent-dir/stats.json", sample(), ClockKind::kReal, 0);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().message.find("/nonexistent-dir/stats.json"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace chimera
