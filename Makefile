@@ -19,7 +19,7 @@ BUILD_TYPE ?= RelWithDebInfo
 export JOBS BUILD_DIR ASAN_DIR TSAN_DIR
 
 # The main job. It may change as the demo grows; everything else refers to this variable.
-DEMO_CMD ?= ./$(BUILD_DIR)/apps/chimera/chimera run examples/fig4_pid_joint.yaml --for 5s
+DEMO_CMD ?= scripts/demo.sh $(BUILD_DIR) 5
 
 # What `make format` and `make tidy` look at.
 FORMAT_DIRS := include src modules sim apps tests bench

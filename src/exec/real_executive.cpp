@@ -128,8 +128,10 @@ bool RealExecutive::Worker::handle(std::uint32_t seq, std::int64_t& k) {
 }
 
 void RealExecutive::Worker::wait_for_predecessors(std::int64_t k, std::int64_t release_abs) const {
-  // Bounded: a predecessor that is late by more than half our deadline no longer holds us back.
-  const std::int64_t give_up = release_abs + task->spec().deadline_ns / 2;
+  // Bounded: a predecessor that keeps us waiting more than half our deadline no longer holds us
+  // back. Counted from when the wait starts, so that the order still holds while tasks catch up
+  // after a stall (when every release is already in the past).
+  const std::int64_t give_up = std::max(release_abs, monotonic_ns()) + task->spec().deadline_ns / 2;
   for (Worker* p : predecessors) {
     for (;;) {
       if (reached(p->completed.load(std::memory_order_acquire), k)) break;  // acquire: its cycle is done

@@ -91,8 +91,9 @@ Result<Params> read_params(const Source& source, const std::optional<Field>& fie
   if (field) {
     if (auto ok = check_free_keys(source, *field, "params"); !ok) return ok.error();
     for (const auto& [value, name] : entries(*field)) {
+      const std::string& key = name;  // clang-tidy 14 cannot parse a lambda capturing a structured binding
       const auto decl = std::find_if(declared.params().begin(), declared.params().end(),
-                                     [&](const ParamDecl& p) { return p.name == name; });
+                                     [&](const ParamDecl& p) { return p.name == key; });
       if (decl == declared.params().end()) {
         std::vector<std::string> known;
         for (const auto& p : declared.params()) known.push_back(p.name);

@@ -223,8 +223,8 @@ TEST(GlobalTableLifetime, LiveOwnerIsRefused) {
                                "); shared memory /chimera_" + name;
   EXPECT_EQ(second.error().message, expected);
   // The refused attempt left the running table alone.
-  const double one = 1.0;
-  first->write(0, &one);
+  const std::vector<std::byte> value(first->shape(0).bytes(), std::byte{1});  // the variable's whole size
+  first->write(0, value.data());
   EXPECT_TRUE(exists(dev_shm_path(name)));
   EXPECT_EQ(first->version(0), 1U);
 }
