@@ -6,9 +6,11 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cstring>
 #include <set>
+#include <system_error>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -32,8 +34,9 @@ constexpr std::int64_t kReplyTimeoutNs = 10'000'000'000;
 void warn_once(std::atomic<bool>& flag, const std::string& message) {
   if (!flag.exchange(true, std::memory_order_relaxed)) spdlog::warn("{}", message);  // a latch only
 }
-std::atomic<bool> g_warned_fifo{false};
-std::atomic<bool> g_warned_mlock{false};
+// Once-only warning latches for the whole process.
+std::atomic<bool> g_warned_fifo{false};   // NOLINT(cppcoreguidelines-avoid-non-const-global-variables): a latch
+std::atomic<bool> g_warned_mlock{false};  // NOLINT(cppcoreguidelines-avoid-non-const-global-variables): a latch
 
 // Release indices are compared modulo 2^32 (the futex word is 32 bits).
 bool reached(std::uint32_t completed_plus_one, std::int64_t k) {
@@ -47,7 +50,7 @@ void prepare_realtime_process(bool realtime) {
   if (kSanitized) return;  // sanitizers map terabytes of shadow memory: locking it is pointless
   if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0)
     warn_once(g_warned_mlock, fmt::format("mlockall refused ({}): memory of real-time tasks may be paged",
-                                          std::strerror(errno)));
+                                          std::generic_category().message(errno)));
 }
 
 struct RealExecutive::Worker {
@@ -78,8 +81,9 @@ struct RealExecutive::Worker {
 
 void RealExecutive::Worker::main() {
   // Touch the stack once so that its pages are resident before the first cycle.
-  volatile char prefault[64 * 1024];
-  std::memset(const_cast<char*>(prefault), 0, sizeof(prefault));  // NOLINT: volatile is the point
+  std::array<char, 64 * 1024> prefault;  // NOLINT(cppcoreguidelines-pro-type-member-init): written next
+  std::memset(prefault.data(), 0, prefault.size());
+  asm volatile("" : : "r"(prefault.data()) : "memory");  // keeps the compiler from dropping the writes
 
   std::uint32_t seen = 0;
   std::int64_t k = 0;
@@ -148,7 +152,7 @@ void RealExecutive::Worker::wait_for_predecessors(std::int64_t k, std::int64_t r
   }
 }
 
-RealExecutive::RealExecutive(std::vector<Task*> tasks, const ReleaseOrder& order, const SubsystemSpec& spec,
+RealExecutive::RealExecutive(const std::vector<Task*>& tasks, const ReleaseOrder& order, const SubsystemSpec& spec,
                              bool realtime)
     : epoch_ns_(monotonic_ns()), realtime_(realtime) {
   // SCHED_FIFO priorities by rate: the shortest period gets the highest priority.
@@ -221,7 +225,7 @@ Result<void> RealExecutive::signal(std::size_t index, Signal sig) {
     }
     pthread_attr_destroy(&attr);
     if (rc != 0)
-      return make_error(Errc::kSystem, fmt::format("{}: cannot start its thread: {}", w.task->name(), std::strerror(rc)));
+      return make_error(Errc::kSystem, fmt::format("{}: cannot start its thread: {}", w.task->name(), std::generic_category().message(rc)));
     w.running = true;
   }
   w.request = sig;

@@ -18,7 +18,7 @@ namespace chimera {
 
 class RealExecutive {
  public:
-  RealExecutive(std::vector<Task*> tasks, const ReleaseOrder& order, const SubsystemSpec& spec, bool realtime);
+  RealExecutive(const std::vector<Task*>& tasks, const ReleaseOrder& order, const SubsystemSpec& spec, bool realtime);
   ~RealExecutive();
   RealExecutive(const RealExecutive&) = delete;
   RealExecutive& operator=(const RealExecutive&) = delete;
@@ -27,7 +27,7 @@ class RealExecutive {
   [[nodiscard]] std::int64_t now_ns() const;
   /// Carries out a signal on the task's own thread (started by spawn, ended by kill) and
   /// waits for it. Not real-time safe; never blocks a task's thread.
-  Result<void> signal(std::size_t task, Signal signal);
+  Result<void> signal(std::size_t index, Signal sig);
 
   struct Worker;
 

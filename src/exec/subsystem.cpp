@@ -70,7 +70,7 @@ struct Subsystem::Impl {
     if (stopped) return stopped_at_ns;
     return virtual_exec ? virtual_exec->now_ns() : real_exec->now_ns();
   }
-  Result<void> signal(std::size_t i, Signal s) {
+  Result<void> signal(std::size_t i, Signal s) const {  // const: the executives are owned, not members' state
     return virtual_exec ? virtual_exec->signal(i, s) : real_exec->signal(i, s);
   }
   std::optional<std::size_t> index_of(std::string_view name) const {

@@ -1,5 +1,6 @@
 #include "chimera/exec/task.hpp"
 
+#include <array>
 #include <exception>
 
 #include <fmt/format.h>
@@ -10,7 +11,7 @@ namespace chimera {
 
 namespace {
 const char* hook_name(std::uint8_t hook) {
-  static constexpr const char* kNames[] = {"on", "cycle", "off", "kill", "error", "clear", "reinit", "sync"};
+  static constexpr std::array<const char*, 8> kNames = {"on", "cycle", "off", "kill", "error", "clear", "reinit", "sync"};
   return kNames[hook];
 }
 }  // namespace

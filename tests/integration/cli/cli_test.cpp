@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -222,6 +224,20 @@ TEST_F(CliTest, RunOnTheRealClock) {
   const auto doc = nlohmann::json::parse(read_text(json));
   EXPECT_EQ(doc.at("clock"), "real");
   EXPECT_GT(doc.at("tasks").at("pid").at("cycles").get<int>(), 0);
+}
+
+TEST_F(CliTest, WithoutRealTimePrivilegeItWarnsOnceAndRunsOnOrdinaryThreads) {
+  // Root: setpriv drops CAP_SYS_NICE, so SCHED_FIFO is refused. Others: a zero rtprio limit.
+  const std::string unprivileged =
+      ::geteuid() == 0 ? "setpriv --inh-caps=-sys_nice --bounding-set=-sys_nice" : "prlimit --rtprio=0:0";
+  const auto o = chimera("run " + copy("fig4.yaml") + " --for 200ms", "", unprivileged);
+  EXPECT_EXIT_CODE(o, 0);
+  std::size_t warnings = 0;
+  for (std::size_t at = o.err.find("SCHED_FIFO is not permitted"); at != std::string::npos;
+       at = o.err.find("SCHED_FIFO is not permitted", at + 1))
+    ++warnings;
+  EXPECT_EQ(warnings, 1u) << o.err;
+  EXPECT_NE(o.out.find("pid"), std::string::npos) << "the timing table is printed";
 }
 
 }  // namespace
