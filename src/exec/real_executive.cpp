@@ -141,7 +141,7 @@ void RealExecutive::Worker::wait_for_predecessors(std::int64_t k, std::int64_t r
       if (reached(p->completed.load(std::memory_order_acquire), k)) break;  // acquire: its cycle is done
       if (p->task->state() != TaskState::kOn) break;
       const std::int64_t s = p->scheduled.load(std::memory_order_acquire);  // acquire: pairs with its store
-      if (s < 0 || s > k) break;  // not released, or joined after this instant
+      if (s < 0 || s > k) break;                           // not released, or joined after this instant
       p->waiters.fetch_add(1, std::memory_order_seq_cst);  // seq_cst: Dekker with the producer (see main)
       const std::uint32_t c = p->completed.load(std::memory_order_seq_cst);
       bool in_time = true;
@@ -179,12 +179,14 @@ RealExecutive::RealExecutive(const std::vector<Task*>& tasks, const ReleaseOrder
     workers_.push_back(std::move(w));
   }
   for (std::size_t i = 0; i < workers_.size(); ++i)
-    for (const int p : order.predecessors[i]) workers_[i]->predecessors.push_back(workers_[static_cast<std::size_t>(p)].get());
+    for (const int p : order.predecessors[i])
+      workers_[i]->predecessors.push_back(workers_[static_cast<std::size_t>(p)].get());
 }
 
 RealExecutive::~RealExecutive() {
   for (auto& w : workers_) {
-    if (w->running && w->task->state() != TaskState::kNotCreated) (void)signal(static_cast<std::size_t>(&w - workers_.data()), Signal::kKill);
+    if (w->running && w->task->state() != TaskState::kNotCreated)
+      (void)signal(static_cast<std::size_t>(&w - workers_.data()), Signal::kKill);
     if (w->running) pthread_join(w->thread, nullptr);
   }
 }
@@ -216,8 +218,9 @@ Result<void> RealExecutive::signal(std::size_t index, Signal sig) {
       pthread_attr_setschedparam(&attr, &sp);
       rc = pthread_create(&w.thread, &attr, worker_entry, &w);
       if (rc == EPERM)
-        warn_once(g_warned_fifo, "SCHED_FIFO is not permitted here: tasks run as ordinary threads "
-                                 "(run as root or grant CAP_SYS_NICE / an rtprio limit for real-time priorities)");
+        warn_once(g_warned_fifo,
+                  "SCHED_FIFO is not permitted here: tasks run as ordinary threads "
+                  "(run as root or grant CAP_SYS_NICE / an rtprio limit for real-time priorities)");
     }
     if (rc == EPERM) {
       pthread_attr_setinheritsched(&attr, PTHREAD_INHERIT_SCHED);
@@ -225,12 +228,13 @@ Result<void> RealExecutive::signal(std::size_t index, Signal sig) {
     }
     pthread_attr_destroy(&attr);
     if (rc != 0)
-      return make_error(Errc::kSystem, fmt::format("{}: cannot start its thread: {}", w.task->name(), std::generic_category().message(rc)));
+      return make_error(Errc::kSystem, fmt::format("{}: cannot start its thread: {}", w.task->name(),
+                                                   std::generic_category().message(rc)));
     w.running = true;
   }
   w.request = sig;
   const std::uint32_t seq = w.request_seq.load(std::memory_order_relaxed) + 1;  // only this thread writes it
-  w.request_seq.store(seq, std::memory_order_release);  // release: publishes `request`
+  w.request_seq.store(seq, std::memory_order_release);                          // release: publishes `request`
   detail::futex_wake_all(w.request_seq);
   const std::int64_t give_up = monotonic_ns() + kReplyTimeoutNs;
   for (;;) {

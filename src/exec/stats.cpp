@@ -10,8 +10,8 @@ namespace chimera {
 int LatencyHistogram::bucket_of(std::int64_t ns) noexcept {
   if (ns < kSubBuckets) return ns < 0 ? 0 : static_cast<int>(ns);
   const auto v = static_cast<std::uint64_t>(ns);
-  const int power = std::bit_width(v) - 1;   // v in [2^power, 2^(power+1))
-  const int shift = power - 5;               // 5 = log2(kSubBuckets)
+  const int power = std::bit_width(v) - 1;  // v in [2^power, 2^(power+1))
+  const int shift = power - 5;              // 5 = log2(kSubBuckets)
   const int sub = static_cast<int>((v >> shift) - kSubBuckets);
   const int bucket = (shift + 1) * kSubBuckets + sub;
   return std::min(bucket, kBuckets - 1);

@@ -84,7 +84,7 @@ Subsystem::Subsystem() : impl_(std::make_unique<Impl>()) {}
 Subsystem::~Subsystem() { stop(); }
 
 Result<std::unique_ptr<Subsystem>> Subsystem::create(const SubsystemSpec& spec, const Registry& registry,
-                                                      RunOptions options) {
+                                                     RunOptions options) {
   std::unique_ptr<Subsystem> s(new Subsystem());
   Impl& m = *s->impl_;
   m.spec = spec;  // the resolution below points into this copy, which never moves
@@ -96,7 +96,8 @@ Result<std::unique_ptr<Subsystem>> Subsystem::create(const SubsystemSpec& spec, 
   for (const auto& t : m.spec.tasks)
     if (t.cpu && *t.cpu >= ncpu)
       return make_error(Errc::kInvalidInput, fmt::format("{}:{}: tasks.{}.cpu: cpu {} does not exist on this machine "
-                                                         "({} CPUs)", spec.file, t.loc.line, t.name, *t.cpu, ncpu));
+                                                         "({} CPUs)",
+                                                         spec.file, t.loc.line, t.name, *t.cpu, ncpu));
 
   m.resolution = resolve_subsystem(m.spec, registry);
   auto violations = verify_subsystem(m.resolution, m.configuration);
@@ -182,8 +183,8 @@ void Subsystem::stop() {
   m.stopped = true;
   m.real_exec.reset();  // joins the threads
   m.virtual_exec.reset();
-  m.collect_events();   // what off and kill reported stays readable, as do the tasks' figures
-  m.table.reset();      // unlinks the shared memory
+  m.collect_events();  // what off and kill reported stays readable, as do the tasks' figures
+  m.table.reset();     // unlinks the shared memory
 }
 
 std::int64_t Subsystem::now_ns() const { return impl_->now(); }

@@ -11,7 +11,8 @@ namespace chimera {
 
 namespace {
 const char* hook_name(std::uint8_t hook) {
-  static constexpr std::array<const char*, 8> kNames = {"on", "cycle", "off", "kill", "error", "clear", "reinit", "sync"};
+  static constexpr std::array<const char*, 8> kNames = {"on",    "cycle", "off",    "kill",
+                                                        "error", "clear", "reinit", "sync"};
   return kNames[hook];
 }
 }  // namespace
@@ -148,9 +149,9 @@ Result<void> Task::turn_on(std::int64_t now_ns) {
     return {};
   }
   const bool recovered = recover(Hook::kOn, s, now_ns);
-  return make_error(Errc::kModuleFault, fmt::format("{}: on failed: {}{}", spec_.name, s.reason(),
-                                                    recovered ? " (error() recovered; task stays OFF)"
-                                                              : "; task is in ERROR"));
+  return make_error(Errc::kModuleFault,
+                    fmt::format("{}: on failed: {}{}", spec_.name, s.reason(),
+                                recovered ? " (error() recovered; task stays OFF)" : "; task is in ERROR"));
 }
 
 Result<void> Task::turn_off(std::int64_t now_ns) {
@@ -188,8 +189,8 @@ Result<void> Task::clear(std::int64_t now_ns) {
   const Status s = call(Hook::kClear);
   if (!s.is_ok()) {
     events_.push(now_ns, "clear refused; still in ERROR: ", s.reason());
-    return make_error(Errc::kModuleFault, fmt::format("{}: clear failed: {}; task stays in ERROR", spec_.name,
-                                                      s.reason()));
+    return make_error(Errc::kModuleFault,
+                      fmt::format("{}: clear failed: {}; task stays in ERROR", spec_.name, s.reason()));
   }
   set_state(TaskState::kOff);
   return {};

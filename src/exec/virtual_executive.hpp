@@ -24,7 +24,7 @@ class VirtualExecutive {
 
  private:
   std::vector<Task*> tasks_;
-  std::vector<std::int64_t> next_release_;  // per task; < 0 when not scheduled
+  std::vector<std::int64_t> next_release_;   // per task; < 0 when not scheduled
   std::vector<std::size_t> dispatch_order_;  // tasks sorted by (period, rank, index)
   std::int64_t now_ns_ = 0;
 };

@@ -61,11 +61,7 @@ bool Params::flag(std::string_view name, bool fallback) const { return get_or(*t
 std::string Params::text(std::string_view name, std::string fallback) const {
   return get_or(*this, name, std::move(fallback));
 }
-Vector Params::vector(std::string_view name, Vector fallback) const {
-  return get_or(*this, name, std::move(fallback));
-}
-Matrix Params::matrix(std::string_view name, Matrix fallback) const {
-  return get_or(*this, name, std::move(fallback));
-}
+Vector Params::vector(std::string_view name, Vector fallback) const { return get_or(*this, name, std::move(fallback)); }
+Matrix Params::matrix(std::string_view name, Matrix fallback) const { return get_or(*this, name, std::move(fallback)); }
 
 }  // namespace chimera

@@ -16,9 +16,9 @@
 #include "support/probe_module.hpp"
 
 extern "C" {
-void* __libc_malloc(std::size_t);  // NOLINT: glibc's own allocator, which the hooks forward to
-void* __libc_calloc(std::size_t, std::size_t);  // NOLINT: same
-void* __libc_realloc(void*, std::size_t);       // NOLINT: same
+void* __libc_malloc(std::size_t);                 // NOLINT: glibc's own allocator, which the hooks forward to
+void* __libc_calloc(std::size_t, std::size_t);    // NOLINT: same
+void* __libc_realloc(void*, std::size_t);         // NOLINT: same
 void* __libc_memalign(std::size_t, std::size_t);  // NOLINT: same
 void __libc_free(void*);                          // NOLINT: same
 }

@@ -2,13 +2,13 @@
 // Test modules for the lifecycle and the executive: a probe whose methods fail or throw on
 // demand and which counts how often each was called, a counter producer and a copying consumer.
 
+#include <unistd.h>
+
 #include <array>
 #include <atomic>
 #include <map>
 #include <stdexcept>
 #include <string>
-
-#include <unistd.h>
 
 #include "chimera/module/registry.hpp"
 

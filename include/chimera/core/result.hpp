@@ -28,7 +28,7 @@ struct Error {
 template <class T>
 class [[nodiscard]] Result {
  public:
-  Result(T value) : v_(std::move(value)) {}  // NOLINT(google-explicit-constructor): returned implicitly
+  Result(T value) : v_(std::move(value)) {}      // NOLINT(google-explicit-constructor): returned implicitly
   Result(Error error) : v_(std::move(error)) {}  // NOLINT(google-explicit-constructor): same
 
   [[nodiscard]] bool ok() const { return v_.index() == 0; }

@@ -43,7 +43,7 @@ class EventRing {
   /// Removes the oldest event into `out`; false if there is none. Consumer side only.
   bool pop(RtEvent& out) noexcept {
     const std::uint64_t tail = tail_.load(std::memory_order_relaxed);  // only the consumer writes tail
-    if (tail == head_.load(std::memory_order_acquire)) return false;  // acquire: see the slot's contents
+    if (tail == head_.load(std::memory_order_acquire)) return false;   // acquire: see the slot's contents
     out = slots_[tail & (N - 1)];
     tail_.store(tail + 1, std::memory_order_release);  // release: our read of the slot is done
     return true;

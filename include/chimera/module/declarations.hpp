@@ -62,8 +62,8 @@ class Declarations {
   /// parameters), so that verification can size other tasks' ports before anything runs.
   void out_const(std::string name, std::vector<double> value, std::string doc) {
     const auto n = static_cast<std::uint32_t>(value.size());
-    ports_.push_back({std::move(name), PortKind::kOutConst, ElemType::kF64, Dim::fixed(n), std::move(value),
-                      std::move(doc)});
+    ports_.push_back(
+        {std::move(name), PortKind::kOutConst, ElemType::kF64, Dim::fixed(n), std::move(value), std::move(doc)});
   }
   void param(std::string name, ParamValue default_value, std::string unit, std::string doc) {
     const ParamType type = param_type_of(default_value);

@@ -46,9 +46,9 @@ namespace chimera {
 /// reference InitContext::timing() hands out. Times come from the subsystem's clock (real or
 /// virtual), so modules that use them stay deterministic on the virtual clock.
 struct CycleTiming {
-  std::int64_t release_ns = 0;     // nominal release of the current cycle, since subsystem start
-  std::int64_t period_ns = 0;      // 0 for an aperiodic task
-  std::uint64_t cycle = 0;         // cycles completed before this one
+  std::int64_t release_ns = 0;  // nominal release of the current cycle, since subsystem start
+  std::int64_t period_ns = 0;   // 0 for an aperiodic task
+  std::uint64_t cycle = 0;      // cycles completed before this one
 };
 
 /// Read-only facts about the running subsystem that any module may look at.

@@ -49,9 +49,9 @@ namespace detail {
 template <class M>
 struct Registration {
   Registration() {
-    auto added = Registry::global().add(ModuleInfo{
-        M::kName, M::kSummary, M::kDoc, [](Declarations& d, const Params& p) { M::declare(d, p); },
-        []() -> std::unique_ptr<Module> { return std::make_unique<M>(); }});
+    auto added = Registry::global().add(ModuleInfo{M::kName, M::kSummary, M::kDoc,
+                                                   [](Declarations& d, const Params& p) { M::declare(d, p); },
+                                                   []() -> std::unique_ptr<Module> { return std::make_unique<M>(); }});
     (void)added;  // a duplicate name keeps the first; `chimera modules` shows which
   }
 };

@@ -16,13 +16,10 @@ enum class ElemType : std::uint8_t { kF64, kF32, kI64, kI32, kU8 };
 constexpr std::size_t elem_size(ElemType t) noexcept {
   switch (t) {
     case ElemType::kF64:
-    case ElemType::kI64:
-      return 8;
+    case ElemType::kI64: return 8;
     case ElemType::kF32:
-    case ElemType::kI32:
-      return 4;
-    case ElemType::kU8:
-      return 1;
+    case ElemType::kI32: return 4;
+    case ElemType::kU8: return 1;
   }
   return 0;
 }
@@ -44,12 +41,30 @@ std::optional<ElemType> parse_elem_type(std::string_view name);
 
 template <class T>
 struct ElemTypeOf;
-template <> struct ElemTypeOf<double> { static constexpr ElemType kValue = ElemType::kF64; };
-template <> struct ElemTypeOf<float> { static constexpr ElemType kValue = ElemType::kF32; };
-template <> struct ElemTypeOf<std::int64_t> { static constexpr ElemType kValue = ElemType::kI64; };
-template <> struct ElemTypeOf<std::int32_t> { static constexpr ElemType kValue = ElemType::kI32; };
-template <> struct ElemTypeOf<std::uint8_t> { static constexpr ElemType kValue = ElemType::kU8; };
-template <> struct ElemTypeOf<bool> { static constexpr ElemType kValue = ElemType::kU8; };
+template <>
+struct ElemTypeOf<double> {
+  static constexpr ElemType kValue = ElemType::kF64;
+};
+template <>
+struct ElemTypeOf<float> {
+  static constexpr ElemType kValue = ElemType::kF32;
+};
+template <>
+struct ElemTypeOf<std::int64_t> {
+  static constexpr ElemType kValue = ElemType::kI64;
+};
+template <>
+struct ElemTypeOf<std::int32_t> {
+  static constexpr ElemType kValue = ElemType::kI32;
+};
+template <>
+struct ElemTypeOf<std::uint8_t> {
+  static constexpr ElemType kValue = ElemType::kU8;
+};
+template <>
+struct ElemTypeOf<bool> {
+  static constexpr ElemType kValue = ElemType::kU8;
+};
 
 /// The element type that stores T; only the five types above compile.
 template <class T>

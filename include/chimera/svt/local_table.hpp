@@ -59,7 +59,7 @@ class LocalTable {
     PortKind kind;
     std::uint32_t offset;  // into storage_
     std::uint32_t bytes;
-    std::uint64_t seen;    // version of the global value held locally
+    std::uint64_t seen;  // version of the global value held locally
   };
   LocalTable() = default;
   Result<const Slot*> find_slot(std::string_view port, bool want_input, ElemType type) const;
@@ -69,12 +69,12 @@ class LocalTable {
 
   GlobalTable* global_ = nullptr;
   std::vector<PortBinding> ports_;
-  std::vector<Slot> slots_;  // parallel to ports_
-  std::vector<Freshness> freshness_;  // parallel to ports_
-  std::vector<std::max_align_t> storage_;  // aligned for any element type
+  std::vector<Slot> slots_;                            // parallel to ports_
+  std::vector<Freshness> freshness_;                   // parallel to ports_
+  std::vector<std::max_align_t> storage_;              // aligned for any element type
   std::array<std::vector<std::uint32_t>, 4> by_kind_;  // indices into slots_, per PortKind: no test per cycle
-  std::vector<std::uint64_t> scratch_;  // read buffer as large as the largest input: a read that
-                                        // a writer laps leaves the local copy whole
+  std::vector<std::uint64_t> scratch_;                 // read buffer as large as the largest input: a read that
+                                                       // a writer laps leaves the local copy whole
 };
 
 }  // namespace chimera

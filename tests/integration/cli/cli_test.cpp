@@ -1,10 +1,10 @@
 // The chimera command as users script it (contract section 2): exit codes, messages, runs.
 
+#include <unistd.h>
+
 #include <filesystem>
 #include <string>
 #include <vector>
-
-#include <unistd.h>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>

@@ -1,12 +1,12 @@
 // Defines a module outside the Chimera tree, registers it with CHIMERA_REGISTER_MODULE, then
 // finds it in the process-wide registry and prints its ports. The package test checks the output.
 
-#include <chimera/module/module.hpp>
-#include <chimera/module/registry.hpp>
-
 #include <cstdio>
 #include <memory>
 #include <string>
+
+#include <chimera/module/module.hpp>
+#include <chimera/module/registry.hpp>
 
 namespace {
 

@@ -46,8 +46,9 @@ TEST(RealExecutive, RunsSignalsAndStopsCleanly) {
 }
 
 TEST(RealExecutive, AFailingTaskGoesToErrorAndTheOtherRunsOn) {
-  auto s = make("  - {name: c, module: counter, period: 2ms}\n"
-                "  - {name: p, module: probe, period: 2ms, params: {fail: cycle, fail_after: 3}}\n");
+  auto s = make(
+      "  - {name: c, module: counter, period: 2ms}\n"
+      "  - {name: p, module: probe, period: 2ms, params: {fail: cycle, fail_after: 3}}\n");
   ASSERT_TRUE(s->start().ok());
   s->run_for(60 * kMs);
   const auto before = s->get("count")->at(0);

@@ -2,11 +2,12 @@
 // released at the same instant as its producer reads the value of that instant, whatever the
 // order of the tasks in the file.
 
+#include "exec/release_order.hpp"
+
 #include <gtest/gtest.h>
 
 #include "chimera/config/loader.hpp"
 #include "chimera/exec/subsystem.hpp"
-#include "exec/release_order.hpp"
 #include "support/probe_module.hpp"
 
 namespace chimera {
@@ -28,29 +29,33 @@ std::unique_ptr<Subsystem> run_file(const std::string& tasks_yaml, std::int64_t 
 }
 
 TEST(ReleaseOrder, ConsumerListedFirstStillReadsTheSameInstantsValue) {
-  auto s = run_file("  - {name: f, module: follower, period: 1ms}\n"
-                    "  - {name: c, module: counter, period: 1ms}\n",
-                    100 * kMs);
+  auto s = run_file(
+      "  - {name: f, module: follower, period: 1ms}\n"
+      "  - {name: c, module: counter, period: 1ms}\n",
+      100 * kMs);
   EXPECT_EQ(s->get("count")->at(0), 100.0);
   EXPECT_EQ(s->get("copy")->at(0), 100.0) << "no cycle of lag";
   EXPECT_EQ(s->get("lagged")->at(0), 0.0);
 }
 
 TEST(ReleaseOrder, ChainOfThreeInReverseFileOrder) {
-  auto s = run_file("  - {name: f2, module: follower, period: 1ms, rename: {count: copy, copy: copy2, lagged: lagged2, follower_cycles: fc2}}\n"
-                    "  - {name: f1, module: follower, period: 1ms}\n"
-                    "  - {name: c, module: counter, period: 1ms}\n",
-                    50 * kMs);
+  auto s = run_file(
+      "  - {name: f2, module: follower, period: 1ms, rename: {count: copy, copy: copy2, lagged: lagged2, "
+      "follower_cycles: fc2}}\n"
+      "  - {name: f1, module: follower, period: 1ms}\n"
+      "  - {name: c, module: counter, period: 1ms}\n",
+      50 * kMs);
   EXPECT_EQ(s->get("copy2")->at(0), 50.0);
   EXPECT_EQ(s->get("lagged2")->at(0), 0.0);
 }
 
 TEST(ReleaseOrder, RanksAndPredecessorsFollowDataFlowAndCutLoopsAtTheFirstListed) {
-  auto spec = load_subsystem_text("subsystem: order\ntasks:\n"
-                                  "  - {name: f, module: follower, period: 1ms}\n"
-                                  "  - {name: c, module: counter, period: 1ms}\n"
-                                  "  - {name: slow, module: follower, period: 2ms, rename: {copy: c2, lagged: l2, follower_cycles: fc3}}\n",
-                                  "order.yaml", testing::test_registry());
+  auto spec = load_subsystem_text(
+      "subsystem: order\ntasks:\n"
+      "  - {name: f, module: follower, period: 1ms}\n"
+      "  - {name: c, module: counter, period: 1ms}\n"
+      "  - {name: slow, module: follower, period: 2ms, rename: {copy: c2, lagged: l2, follower_cycles: fc3}}\n",
+      "order.yaml", testing::test_registry());
   ASSERT_TRUE(spec.ok()) << spec.error().message;
   const auto resolution = resolve_subsystem(*spec, testing::test_registry());
   const ReleaseOrder order = compute_release_order(resolution.subsystem);

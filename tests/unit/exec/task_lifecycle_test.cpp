@@ -24,9 +24,12 @@ constexpr std::int64_t kMs = 1'000'000;
 /// A subsystem with one probe `p` (params given as YAML flow text) and one healthy counter `c`.
 std::unique_ptr<Subsystem> make(const std::string& probe_params, bool start = true) {
   calls().clear();
-  const std::string text = "subsystem: life\ntasks:\n"
-                           "  - {name: p, module: probe, period: 1ms, params: " + probe_params + "}\n"
-                           "  - {name: c, module: counter, period: 1ms}\n";
+  const std::string text =
+      "subsystem: life\ntasks:\n"
+      "  - {name: p, module: probe, period: 1ms, params: " +
+      probe_params +
+      "}\n"
+      "  - {name: c, module: counter, period: 1ms}\n";
   auto spec = load_subsystem_text(text, "life.yaml", testing::test_registry());
   EXPECT_TRUE(spec.ok()) << (spec.ok() ? "" : spec.error().message);
   RunOptions o;

@@ -17,16 +17,26 @@ TEST(LifecycleState, TransitionTableMatchesFigure7) {
     std::optional<S> to;
   };
   const Row expected[] = {
-      {S::kNotCreated, Signal::kSpawn, S::kOff}, {S::kNotCreated, Signal::kOn, {}},
-      {S::kNotCreated, Signal::kOff, {}},        {S::kNotCreated, Signal::kKill, {}},
-      {S::kNotCreated, Signal::kClear, {}},      {S::kOff, Signal::kSpawn, {}},
-      {S::kOff, Signal::kOn, S::kOn},            {S::kOff, Signal::kOff, {}},
-      {S::kOff, Signal::kKill, S::kNotCreated},  {S::kOff, Signal::kClear, {}},
-      {S::kOn, Signal::kSpawn, {}},              {S::kOn, Signal::kOn, {}},
-      {S::kOn, Signal::kOff, S::kOff},           {S::kOn, Signal::kKill, S::kNotCreated},
-      {S::kOn, Signal::kClear, {}},              {S::kError, Signal::kSpawn, {}},
-      {S::kError, Signal::kOn, {}},              {S::kError, Signal::kOff, {}},
-      {S::kError, Signal::kKill, S::kNotCreated}, {S::kError, Signal::kClear, S::kOff},
+      {S::kNotCreated, Signal::kSpawn, S::kOff},
+      {S::kNotCreated, Signal::kOn, {}},
+      {S::kNotCreated, Signal::kOff, {}},
+      {S::kNotCreated, Signal::kKill, {}},
+      {S::kNotCreated, Signal::kClear, {}},
+      {S::kOff, Signal::kSpawn, {}},
+      {S::kOff, Signal::kOn, S::kOn},
+      {S::kOff, Signal::kOff, {}},
+      {S::kOff, Signal::kKill, S::kNotCreated},
+      {S::kOff, Signal::kClear, {}},
+      {S::kOn, Signal::kSpawn, {}},
+      {S::kOn, Signal::kOn, {}},
+      {S::kOn, Signal::kOff, S::kOff},
+      {S::kOn, Signal::kKill, S::kNotCreated},
+      {S::kOn, Signal::kClear, {}},
+      {S::kError, Signal::kSpawn, {}},
+      {S::kError, Signal::kOn, {}},
+      {S::kError, Signal::kOff, {}},
+      {S::kError, Signal::kKill, S::kNotCreated},
+      {S::kError, Signal::kClear, S::kOff},
   };
   int checked = 0;
   for (const S s : kStates)
