@@ -22,6 +22,7 @@
 #include "commands.hpp"
 #include "exit_codes.hpp"
 #include "line_reader.hpp"
+#include "load_file.hpp"
 #include "stop_request.hpp"
 
 namespace chimera::cli {
@@ -144,15 +145,8 @@ class Session {
 
 int run_command(const RunArgs& args) {
   const Registry& registry = Registry::global();
-  auto spec = load_subsystem_file(args.file, registry);
-  if (!spec) {
-    fmt::print(stderr, "{}\n", spec.error().message);
-    return kExitInvalid;
-  }
-  if (args.config && spec->find_configuration(*args.config) == nullptr) {
-    fmt::print(stderr, "{}: unknown configuration '{}'\n", args.file, *args.config);
-    return kExitInvalid;
-  }
+  auto spec = load_file(args.file, args.config);
+  if (!spec) return kExitInvalid;
   if (args.stats_json) {
     if (auto writable = check_writable(*args.stats_json); !writable) {
       fmt::print(stderr, "{}\n", writable.error().message);

@@ -11,20 +11,14 @@
 #include "chimera/module/registry.hpp"
 #include "commands.hpp"
 #include "exit_codes.hpp"
+#include "load_file.hpp"
 
 namespace chimera::cli {
 
 int verify_command(const VerifyArgs& args) {
   const Registry& registry = Registry::global();
-  auto spec = load_subsystem_file(args.file, registry);
-  if (!spec) {
-    fmt::print(stderr, "{}\n", spec.error().message);
-    return kExitInvalid;
-  }
-  if (args.config && spec->find_configuration(*args.config) == nullptr) {
-    fmt::print(stderr, "{}: unknown configuration '{}'\n", args.file, *args.config);
-    return kExitInvalid;
-  }
+  auto spec = load_file(args.file, args.config);
+  if (!spec) return kExitInvalid;
 
   const Resolution resolution = resolve_subsystem(*spec, registry);
   const auto violations = verify_subsystem(resolution, args.config);

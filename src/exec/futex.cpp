@@ -15,6 +15,7 @@ namespace {
 long futex(const std::atomic<std::uint32_t>& word, int op, std::uint32_t value, const timespec* timeout) noexcept {
   // The kernel reads the word itself; the cast drops const because the syscall's type demands it.
   auto* addr = const_cast<std::uint32_t*>(reinterpret_cast<const std::uint32_t*>(&word));  // NOLINT: syscall ABI
+  // NOLINTNEXTLINE(cppcoreguidelines-pro-type-vararg): glibc has no futex wrapper; syscall() is the way in
   return syscall(SYS_futex, addr, op, value, timeout, nullptr, FUTEX_BITSET_MATCH_ANY);
 }
 }  // namespace

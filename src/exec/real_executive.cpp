@@ -81,7 +81,7 @@ struct RealExecutive::Worker {
 
 void RealExecutive::Worker::main() {
   // Touch the stack once so that its pages are resident before the first cycle.
-  std::array<char, 64 * 1024> prefault;  // NOLINT(cppcoreguidelines-pro-type-member-init): written next
+  std::array<char, std::size_t{64} * 1024> prefault;  // NOLINT(cppcoreguidelines-pro-type-member-init): written next
   std::memset(prefault.data(), 0, prefault.size());
   asm volatile("" : : "r"(prefault.data()) : "memory");  // keeps the compiler from dropping the writes
 

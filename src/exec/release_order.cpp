@@ -1,12 +1,13 @@
 #include "release_order.hpp"
 
-#include <algorithm>
+#include <cstdint>
 #include <set>
-#include <string>
 
 namespace chimera {
 
 namespace {
+
+/// Whether `producer` publishes an out-var that `consumer` reads as an in-var.
 bool feeds(const ResolvedTask& producer, const ResolvedTask& consumer) {
   for (const auto& out : producer.bindings) {
     if (out.kind != PortKind::kOutVar) continue;
@@ -15,60 +16,57 @@ bool feeds(const ResolvedTask& producer, const ResolvedTask& consumer) {
   }
   return false;
 }
+
+/// Indices of the tasks of `group` in data-flow order: Kahn's algorithm taking the earliest task
+/// of the file among the ready ones; when only cycles remain, the earliest remaining task of the
+/// file goes next (the loop is cut before it).
+std::vector<int> data_flow_order(const std::vector<ResolvedTask>& tasks, const std::vector<int>& group) {
+  auto task = [&](int i) -> const ResolvedTask& { return tasks[static_cast<std::size_t>(i)]; };
+  std::set<int> left(group.begin(), group.end());
+  std::vector<int> order;
+  while (!left.empty()) {
+    int pick = *left.begin();  // the fallback that cuts a loop
+    for (const int c : left) {
+      bool ready = true;
+      for (const int q : left) ready = ready && (q == c || !feeds(task(q), task(c)));
+      if (ready) {
+        pick = c;
+        break;
+      }
+    }
+    order.push_back(pick);
+    left.erase(pick);
+  }
+  return order;
+}
+
 }  // namespace
 
 ReleaseOrder compute_release_order(const ResolvedSubsystem& subsystem) {
   const auto& tasks = subsystem.tasks;
-  const int n = static_cast<int>(tasks.size());
-  ReleaseOrder order;
-  order.rank.assign(static_cast<std::size_t>(n), 0);
-  order.predecessors.assign(static_cast<std::size_t>(n), {});
+  const std::size_t n = tasks.size();
+  ReleaseOrder result;
+  result.rank.assign(n, 0);
+  result.predecessors.assign(n, {});
 
-  auto period = [&](int i) { return tasks[static_cast<std::size_t>(i)].spec->period_ns.value_or(-1); };
-  std::set<long long> periods;
-  for (int i = 0; i < n; ++i)
-    if (period(i) > 0) periods.insert(period(i));
+  std::set<std::int64_t> periods;
+  for (const auto& t : tasks)
+    if (t.spec->period_ns) periods.insert(*t.spec->period_ns);
 
-  for (const long long p : periods) {
-    std::vector<int> group;
-    for (int i = 0; i < n; ++i)
-      if (period(i) == p) group.push_back(i);
-    // Kahn's algorithm, taking the earliest task in the file among the ready ones; when only
-    // cycles remain, the earliest task of the file goes next (the loop is cut before it).
-    std::vector<int> placed;
-    std::vector<bool> done(static_cast<std::size_t>(n), false);
-    while (placed.size() < group.size()) {
-      int pick = -1;
-      for (const int c : group) {
-        if (done[static_cast<std::size_t>(c)]) continue;
-        bool ready = true;
-        for (const int q : group)
-          if (q != c && !done[static_cast<std::size_t>(q)] &&
-              feeds(tasks[static_cast<std::size_t>(q)], tasks[static_cast<std::size_t>(c)]))
-            ready = false;
-        if (ready) {
-          pick = c;
-          break;
-        }
-      }
-      if (pick < 0) {
-        for (const int c : group)
-          if (!done[static_cast<std::size_t>(c)]) {
-            pick = c;
-            break;
-          }
-      }
-      done[static_cast<std::size_t>(pick)] = true;
-      order.rank[static_cast<std::size_t>(pick)] = static_cast<int>(placed.size());
-      placed.push_back(pick);
-    }
-    for (const int c : group)
-      for (const int q : group)
-        if (order.rank[static_cast<std::size_t>(q)] < order.rank[static_cast<std::size_t>(c)] &&
-            feeds(tasks[static_cast<std::size_t>(q)], tasks[static_cast<std::size_t>(c)]))
-          order.predecessors[static_cast<std::size_t>(c)].push_back(q);
+  for (const std::int64_t p : periods) {
+    std::vector<int> group;  // in file order
+    for (std::size_t i = 0; i < n; ++i)
+      if (tasks[i].spec->period_ns == p) group.push_back(static_cast<int>(i));
+    const std::vector<int> order = data_flow_order(tasks, group);
+    for (std::size_t r = 0; r < order.size(); ++r)
+      result.rank[static_cast<std::size_t>(order[r])] = static_cast<int>(r);
+    // A task waits only for producers placed before it; a loop's back edge reads the last cycle.
+    for (std::size_t r = 0; r < order.size(); ++r)
+      for (std::size_t q = 0; q < r; ++q)
+        if (feeds(tasks[static_cast<std::size_t>(order[q])], tasks[static_cast<std::size_t>(order[r])]))
+          result.predecessors[static_cast<std::size_t>(order[r])].push_back(order[q]);
   }
-  return order;
+  return result;
 }
 
 }  // namespace chimera

@@ -10,8 +10,8 @@ namespace chimera {
 int LatencyHistogram::bucket_of(std::int64_t ns) noexcept {
   if (ns < kSubBuckets) return ns < 0 ? 0 : static_cast<int>(ns);
   const auto v = static_cast<std::uint64_t>(ns);
-  const int power = std::bit_width(v) - 1;  // v in [2^power, 2^(power+1))
-  const int shift = power - 5;              // 5 = log2(kSubBuckets)
+  const int power = static_cast<int>(std::bit_width(v)) - 1;  // v in [2^power, 2^(power+1))
+  const int shift = power - 5;                                // 5 = log2(kSubBuckets)
   const int sub = static_cast<int>((v >> shift) - kSubBuckets);
   const int bucket = (shift + 1) * kSubBuckets + sub;
   return std::min(bucket, kBuckets - 1);
@@ -68,7 +68,7 @@ TaskStatsSnapshot TaskStats::snapshot() const noexcept {
   s.cycles = cycles_.load(std::memory_order_relaxed);  // figures may be one cycle apart: fine for a table
   s.missed = missed_.load(std::memory_order_relaxed);
   const std::int64_t sum = exec_sum_ns_.load(std::memory_order_relaxed);
-  s.exec_mean_ns = s.cycles ? sum / static_cast<std::int64_t>(s.cycles) : 0;
+  s.exec_mean_ns = s.cycles != 0 ? sum / static_cast<std::int64_t>(s.cycles) : 0;
   s.exec_max_ns = exec_max_ns_.load(std::memory_order_relaxed);
   s.latency_p50_ns = latency_.percentile(0.50);
   s.latency_p99_ns = latency_.percentile(0.99);

@@ -20,7 +20,7 @@ ParamType param_type_of(const ParamValue& v) { return static_cast<ParamType>(v.i
 namespace {
 std::string join_numbers(const Vector& v) {
   std::string out = "[";
-  for (std::size_t i = 0; i < v.size(); ++i) out += fmt::format("{}{}", i ? ", " : "", v[i]);
+  for (std::size_t i = 0; i < v.size(); ++i) out += fmt::format("{}{}", i != 0 ? ", " : "", v[i]);
   return out + "]";
 }
 }  // namespace
@@ -34,7 +34,7 @@ std::string to_string(const ParamValue& v) {
     case ParamType::kMatrix: {
       const auto& m = std::get<Matrix>(v);
       std::string out = "[";
-      for (std::size_t i = 0; i < m.size(); ++i) out += (i ? ", " : "") + join_numbers(m[i]);
+      for (std::size_t i = 0; i < m.size(); ++i) out += (i != 0 ? ", " : "") + join_numbers(m[i]);
       return out + "]";
     }
   }

@@ -1,93 +1,22 @@
-// The real-time path allocates nothing. This program replaces the allocator: while armed, every
-// allocation is counted, and operator new fails by throwing. Cycles of the framework (transfers,
-// statistics, timing, dispatch) and of the Figure 4 modules run armed, on both clocks.
+// The real-time path allocates nothing. While an AllocationGuard is armed every allocation is
+// counted and operator new fails by throwing. Cycles of the framework (transfers, statistics,
+// timing, dispatch) and of the Figure 4 modules run armed, on both clocks.
 
-#include <malloc.h>
-
-#include <atomic>
-#include <cstdlib>
-#include <new>
 #include <vector>
 
 #include <gtest/gtest.h>
 
 #include "chimera/config/loader.hpp"
 #include "chimera/exec/subsystem.hpp"
+#include "support/allocation_guard.hpp"
 #include "support/probe_module.hpp"
-
-extern "C" {
-void* __libc_malloc(std::size_t);                 // NOLINT: glibc's own allocator, which the hooks forward to
-void* __libc_calloc(std::size_t, std::size_t);    // NOLINT: same
-void* __libc_realloc(void*, std::size_t);         // NOLINT: same
-void* __libc_memalign(std::size_t, std::size_t);  // NOLINT: same
-void __libc_free(void*);                          // NOLINT: same
-}
-
-namespace {
-std::atomic<bool> g_armed{false};
-std::atomic<long> g_allocations{0};
-
-void note() {
-  // relaxed: a flag and a counter read after the threads that count have been joined or parked
-  if (g_armed.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
-}
-}  // namespace
-
-extern "C" {
-void* malloc(std::size_t n) {  // NOLINT: replaces the C allocator for this test program
-  note();
-  return __libc_malloc(n);
-}
-void* calloc(std::size_t n, std::size_t m) {  // NOLINT: same
-  note();
-  return __libc_calloc(n, m);
-}
-void* realloc(void* p, std::size_t n) {  // NOLINT: same
-  note();
-  return __libc_realloc(p, n);
-}
-void* memalign(std::size_t a, std::size_t n) {  // NOLINT: same
-  note();
-  return __libc_memalign(a, n);
-}
-void* aligned_alloc(std::size_t a, std::size_t n) {  // NOLINT: same
-  note();
-  return __libc_memalign(a, n);
-}
-int posix_memalign(void** out, std::size_t a, std::size_t n) {  // NOLINT: same
-  note();
-  *out = __libc_memalign(a, n);
-  return *out ? 0 : ENOMEM;
-}
-void free(void* p) { __libc_free(p); }  // NOLINT: same
-}
-
-void* operator new(std::size_t n) {
-  if (g_armed.load(std::memory_order_relaxed)) {  // relaxed: see note()
-    g_allocations.fetch_add(1, std::memory_order_relaxed);
-    throw std::bad_alloc();
-  }
-  if (void* p = __libc_malloc(n)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t n) { return operator new(n); }
-void operator delete(void* p) noexcept { __libc_free(p); }
-void operator delete[](void* p) noexcept { __libc_free(p); }
-void operator delete(void* p, std::size_t) noexcept { __libc_free(p); }
-void operator delete[](void* p, std::size_t) noexcept { __libc_free(p); }
 
 namespace chimera {
 namespace {
 
 constexpr std::int64_t kMs = 1'000'000;
 
-struct Armed {
-  Armed() {
-    g_allocations.store(0);
-    g_armed.store(true);
-  }
-  ~Armed() { g_armed.store(false); }
-};
+using testing::AllocationGuard;
 
 std::unique_ptr<Subsystem> fig4(ClockKind clock) {
   auto spec = load_subsystem_file(CHIMERA_EXAMPLES_DIR "/fig4_pid_joint.yaml", Registry::global());
@@ -112,11 +41,13 @@ TEST(NoAllocationInCycle, Figure4OnTheVirtualClock) {
   auto s = fig4(ClockKind::kVirtual);
   s->run_for(100 * kMs);  // warm up: first touches, lazy initialisation
   const auto before = total_cycles(*s);
+  long allocations = 0;
   {
-    Armed armed;
+    AllocationGuard guard(AllocationGuard::OnNew::kFail);
     s->run_for(2000 * kMs);
+    allocations = AllocationGuard::count();
   }
-  EXPECT_EQ(g_allocations.load(), 0) << "allocations inside cycles";
+  EXPECT_EQ(allocations, 0) << "allocations inside cycles";
   EXPECT_EQ(total_cycles(*s) - before, s->snapshot().size() * 2000u);
   for (const auto& t : s->snapshot()) EXPECT_EQ(t.state, TaskState::kOn) << t.name;
 }
@@ -125,13 +56,41 @@ TEST(NoAllocationInCycle, Figure4OnTheRealClock) {
   auto s = fig4(ClockKind::kReal);
   s->run_for(100 * kMs);
   const auto before = total_cycles(*s);
+  long allocations = 0;
   {
-    Armed armed;
+    AllocationGuard guard(AllocationGuard::OnNew::kFail);
     s->run_for(300 * kMs);  // every thread is counted, this one sleeps
+    allocations = AllocationGuard::count();
   }
-  EXPECT_EQ(g_allocations.load(), 0) << "allocations inside cycles";
+  EXPECT_EQ(allocations, 0) << "allocations inside cycles";
   EXPECT_GT(total_cycles(*s), before + 300);
   for (const auto& t : s->snapshot()) EXPECT_EQ(t.state, TaskState::kOn) << t.name;
+}
+
+TEST(NoAllocationInCycle, Figure4WithSensorNoise) {
+  const char* text = R"(subsystem: fig4_noise
+tasks:
+  - { name: traj, module: joint_traj_gen, period: 1ms }
+  - { name: pid, module: pid_joint, period: 1ms }
+  - { name: robot, module: robot_torque, period: 1ms, params: { noise_std: 0.001 } }
+)";
+  auto spec = load_subsystem_text(text, "fig4_noise.yaml", Registry::global());
+  ASSERT_TRUE(spec.ok()) << spec.error().message;
+  RunOptions o;
+  o.clock = ClockKind::kVirtual;
+  o.shm_suffix = testing::unique_suffix();
+  auto s = Subsystem::create(*spec, Registry::global(), o);
+  ASSERT_TRUE(s.ok()) << s.error().message;
+  ASSERT_TRUE((*s)->start().ok());
+  (*s)->run_for(10 * kMs);
+  long allocations = 0;
+  {
+    AllocationGuard guard(AllocationGuard::OnNew::kFail);
+    (*s)->run_for(500 * kMs);
+    allocations = AllocationGuard::count();
+  }
+  EXPECT_EQ(allocations, 0) << "allocations during 500 cycles of each task";
+  EXPECT_EQ(total_cycles(**s), 3u * 510u);
 }
 
 // The detector detects: a module that allocates in cycle() is caught, and its task goes to ERROR.
@@ -161,11 +120,13 @@ TEST(NoAllocationInCycle, AnAllocatingModuleIsCaught) {
   auto s = Subsystem::create(*spec, reg, o);
   ASSERT_TRUE(s.ok());
   ASSERT_TRUE((*s)->start().ok());
+  long allocations = 0;
   {
-    Armed armed;
+    AllocationGuard guard(AllocationGuard::OnNew::kFail);
     (*s)->run_for(5 * kMs);
+    allocations = AllocationGuard::count();
   }
-  EXPECT_GT(g_allocations.load(), 0);
+  EXPECT_GT(allocations, 0);
   EXPECT_EQ((*s)->snapshot()[0].state, TaskState::kError) << "the failed allocation is the module's fault";
 }
 

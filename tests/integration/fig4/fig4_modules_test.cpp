@@ -1,13 +1,8 @@
 // The three modules of Figure 4 one by one: their declared ports against the contract (section 3),
-// the trajectory and PID laws, and no allocation while the closed loop cycles.
-
-#include <unistd.h>
+// and the trajectory and PID laws.
 
 #include <array>
-#include <atomic>
 #include <cmath>
-#include <cstdlib>
-#include <new>
 #include <span>
 #include <string>
 #include <vector>
@@ -19,37 +14,6 @@
 #include "chimera/module/registry.hpp"
 #include "joint_traj_gen/quintic_via.hpp"
 #include "pid_joint/pid_law.hpp"
-
-// A sanitizer brings its own allocator; replacing operator new beside it proves nothing, so the
-// allocation count is a check of the plain build only (as in tests/rt).
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-#define CHIMERA_COUNT_ALLOCATIONS 0
-#else
-#define CHIMERA_COUNT_ALLOCATIONS 1
-#endif
-
-namespace {
-
-// Counts C++ allocations while armed: the closed loop must make none.
-std::atomic<bool> g_counting{false};  // NOLINT(cppcoreguidelines-avoid-non-const-global-variables): the hook's switch
-std::atomic<int> g_allocations{0};    // NOLINT(cppcoreguidelines-avoid-non-const-global-variables): the hook's count
-
-}  // namespace
-
-#if CHIMERA_COUNT_ALLOCATIONS
-// noinline: GCC 12 otherwise pairs the inlined free() with operator new and warns
-// (-Wmismatched-new-delete), although the replacements are a matched pair.
-[[gnu::noinline]] void* operator new(std::size_t size) {
-  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
-  // NOLINTNEXTLINE(cppcoreguidelines-no-malloc): this is the allocator
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-[[gnu::noinline]] void operator delete(void* p) noexcept { std::free(p); }  // NOLINT(cppcoreguidelines-no-malloc)
-[[gnu::noinline]] void operator delete(void* p, std::size_t /*size*/) noexcept {
-  std::free(p);  // NOLINT(cppcoreguidelines-no-malloc): this is the allocator
-}
-#endif
 
 namespace chimera {
 namespace {
@@ -212,35 +176,7 @@ TEST(Fig4Modules, PidIntegralIsBounded) {
   EXPECT_DOUBLE_EQ(pid_out(pid, 1.0, 0.0, 0.0, 0.0), 0.01);
 }
 
-// ---- the closed loop allocates nothing while it cycles ------------------------------------------
-
-TEST(Fig4Modules, CyclesDoNotAllocate) {
-  if (!CHIMERA_COUNT_ALLOCATIONS) GTEST_SKIP() << "allocations are not counted under a sanitizer";
-  const char* text = R"(subsystem: fig4_noalloc
-tasks:
-  - { name: traj, module: joint_traj_gen, period: 1ms }
-  - { name: pid, module: pid_joint, period: 1ms }
-  - { name: robot, module: robot_torque, period: 1ms, params: { noise_std: 0.001 } }
-configurations:
-  pid_control: [traj, pid, robot]
-)";
-  auto spec = load_subsystem_text(text, "fig4_noalloc.yaml", Registry::global());
-  ASSERT_TRUE(spec.ok()) << spec.error().message;
-  RunOptions options;
-  options.clock = ClockKind::kVirtual;
-  options.shm_suffix = "_fig4_noalloc_" + std::to_string(::getpid());
-  auto sub = Subsystem::create(*spec, Registry::global(), options);
-  ASSERT_TRUE(sub.ok()) << sub.error().message;
-  auto started = (*sub)->start();
-  ASSERT_TRUE(started.ok()) << started.error().message;
-  (*sub)->run_for(10 * kMs);  // let anything lazy happen first
-  g_allocations = 0;
-  g_counting = true;
-  (*sub)->run_for(500 * kMs);
-  g_counting = false;
-  EXPECT_EQ(g_allocations.load(), 0) << "allocations during 500 cycles of each task";
-  (*sub)->stop();
-}
+// The closed loop's freedom from allocation is proven in tests/rt/no_allocation_in_cycle_test.cpp.
 
 }  // namespace
 }  // namespace chimera

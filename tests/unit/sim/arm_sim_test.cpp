@@ -16,36 +16,7 @@
 
 #include <gtest/gtest.h>
 
-// A sanitizer brings its own allocator; replacing operator new beside it proves nothing, so the
-// allocation count is a check of the plain build only (as in tests/rt).
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-#define CHIMERA_COUNT_ALLOCATIONS 0
-#else
-#define CHIMERA_COUNT_ALLOCATIONS 1
-#endif
-
-namespace {
-
-// Counts C++ allocations while armed: step() and friends must make none.
-std::atomic<bool> g_counting{false};  // NOLINT(cppcoreguidelines-avoid-non-const-global-variables): the hook's switch
-std::atomic<int> g_allocations{0};    // NOLINT(cppcoreguidelines-avoid-non-const-global-variables): the hook's count
-
-}  // namespace
-
-#if CHIMERA_COUNT_ALLOCATIONS
-// noinline: GCC 12 otherwise pairs the inlined free() with operator new and warns
-// (-Wmismatched-new-delete), although the replacements are a matched pair.
-[[gnu::noinline]] void* operator new(std::size_t size) {
-  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
-  // NOLINTNEXTLINE(cppcoreguidelines-no-malloc): this is the allocator
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-[[gnu::noinline]] void operator delete(void* p) noexcept { std::free(p); }  // NOLINT(cppcoreguidelines-no-malloc)
-[[gnu::noinline]] void operator delete(void* p, std::size_t /*size*/) noexcept {
-  std::free(p);  // NOLINT(cppcoreguidelines-no-malloc): this is the allocator
-}
-#endif
+#include "support/allocation_guard.hpp"
 
 namespace chimera::sim {
 namespace {
@@ -236,24 +207,27 @@ TEST(ArmSim, SetStatePutsTheArmThere) {
   EXPECT_EQ(arm->time_ns(), 0);
 }
 
+#if CHIMERA_ALLOCATION_GUARD  // plain builds: a sanitizer brings its own allocator
 TEST(ArmSim, RealTimeCallsDoNotAllocate) {
-  if (!CHIMERA_COUNT_ALLOCATIONS) GTEST_SKIP() << "allocations are not counted under a sanitizer";
   auto arm = load_arm(SensorNoise{0.001, 0.001, 3});
   ASSERT_NE(arm, nullptr);
   const std::vector<double> tau{1, 2, 3, 0.1, 0.2, 0.3};
   const std::vector<double> q(6, 0.1);
-  g_allocations = 0;
-  g_counting = true;
-  for (int k = 0; k < 100; ++k) {
-    arm->set_torque(tau);
-    arm->step(k % 3 == 0 ? 2'500'000 : kMs);
-    volatile double sink = arm->positions()[0] + arm->velocities()[0] + arm->torque()[0] + arm->time_s();
-    (void)sink;
+  long allocations = 0;
+  {
+    testing::AllocationGuard guard;
+    for (int k = 0; k < 100; ++k) {
+      arm->set_torque(tau);
+      arm->step(k % 3 == 0 ? 2'500'000 : kMs);
+      volatile double sink = arm->positions()[0] + arm->velocities()[0] + arm->torque()[0] + arm->time_s();
+      (void)sink;
+    }
+    arm->set_state(q, q);
+    allocations = testing::AllocationGuard::count();
   }
-  arm->set_state(q, q);
-  g_counting = false;
-  EXPECT_EQ(g_allocations.load(), 0);
+  EXPECT_EQ(allocations, 0);
 }
+#endif
 
 TEST(ArmSim, AMissingModelNamesThePath) {
   auto r = ArmSim::load("/nonexistent/chimera/arm.xml");
