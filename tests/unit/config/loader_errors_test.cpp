@@ -7,19 +7,12 @@
 
 #include "chimera/config/loader.hpp"
 #include "unit/config/fake_modules.hpp"
+#include "unit/config/load_error.hpp"
 
 namespace chimera {
 namespace {
 
-const Registry& registry() { return test::config_test_registry(); }
-
-std::string error_of(std::string_view text) {
-  auto r = load_subsystem_text(text, "pid.yaml", registry());
-  EXPECT_FALSE(r.ok()) << "loaded:\n" << text;
-  if (r.ok()) return {};
-  EXPECT_EQ(r.error().code, Errc::kInvalidInput);
-  return r.error().message;
-}
+using test::error_of;
 
 // A task list to append to headers under test.
 constexpr const char* kOneTask = "tasks:\n  - {name: a, module: visual_servo}\n";
