@@ -147,7 +147,10 @@ void RealExecutive::Worker::wait_for_predecessors(std::int64_t k, std::int64_t r
       bool in_time = true;
       if (!reached(c, k)) in_time = detail::futex_wait(p->completed, c, give_up);
       p->waiters.fetch_sub(1, std::memory_order_relaxed);  // only a hint for the producer's wake
-      if (!in_time && monotonic_ns() >= give_up) break;
+      if (!in_time && monotonic_ns() >= give_up) {
+        task->record_order_timeout();
+        return;  // past the bound: run with what the table holds
+      }
     }
   }
 }

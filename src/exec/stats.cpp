@@ -63,6 +63,11 @@ void TaskStats::record_cycle(std::int64_t latency_ns, std::int64_t exec_ns, bool
   if (exec_ns > exec_max_ns_.load(std::memory_order_relaxed)) exec_max_ns_.store(exec_ns, std::memory_order_relaxed);
 }
 
+void TaskStats::record_order_timeout() noexcept {
+  // Single writer (the task's thread); relaxed: a counter read on its own.
+  order_timeouts_.store(order_timeouts_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+}
+
 TaskStatsSnapshot TaskStats::snapshot() const noexcept {
   TaskStatsSnapshot s;
   s.cycles = cycles_.load(std::memory_order_relaxed);  // figures may be one cycle apart: fine for a table
@@ -73,6 +78,7 @@ TaskStatsSnapshot TaskStats::snapshot() const noexcept {
   s.latency_p50_ns = latency_.percentile(0.50);
   s.latency_p99_ns = latency_.percentile(0.99);
   s.latency_max_ns = latency_.max();
+  s.order_timeouts = order_timeouts_.load(std::memory_order_relaxed);
   return s;
 }
 
@@ -80,6 +86,7 @@ void TaskStats::reset() noexcept {
   latency_.reset();
   cycles_.store(0, std::memory_order_relaxed);  // only while the writer is idle
   missed_.store(0, std::memory_order_relaxed);
+  order_timeouts_.store(0, std::memory_order_relaxed);
   exec_sum_ns_.store(0, std::memory_order_relaxed);
   exec_max_ns_.store(0, std::memory_order_relaxed);
 }

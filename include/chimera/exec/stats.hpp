@@ -43,6 +43,9 @@ struct TaskStatsSnapshot {
   std::int64_t latency_p50_ns = 0;  // release to start of cycle
   std::int64_t latency_p99_ns = 0;
   std::int64_t latency_max_ns = 0;
+  /// Cycles that started without a same-rate producer's value of the same release because the
+  /// producer kept them waiting past the bound (real clock only; see docs/architecture.md).
+  std::uint64_t order_timeouts = 0;
 };
 
 /// Everything the framework counts for one task. Written only by the task's thread.
@@ -50,6 +53,8 @@ class TaskStats {
  public:
   /// One finished cycle. Real-time safe.
   void record_cycle(std::int64_t latency_ns, std::int64_t exec_ns, bool missed) noexcept;
+  /// A precedence wait gave up. Real-time safe.
+  void record_order_timeout() noexcept;
   [[nodiscard]] TaskStatsSnapshot snapshot() const noexcept;
   void reset() noexcept;
 
@@ -57,6 +62,7 @@ class TaskStats {
   LatencyHistogram latency_;
   std::atomic<std::uint64_t> cycles_{0};
   std::atomic<std::uint64_t> missed_{0};
+  std::atomic<std::uint64_t> order_timeouts_{0};
   std::atomic<std::int64_t> exec_sum_ns_{0};
   std::atomic<std::int64_t> exec_max_ns_{0};
 };

@@ -57,6 +57,8 @@ class Task {
                  bool clock_is_virtual) noexcept;
 
   [[nodiscard]] const TaskStats& stats() const { return stats_; }
+  /// The executive gave up waiting for a same-rate producer. Real-time safe.
+  void record_order_timeout() noexcept { stats_.record_order_timeout(); }
   [[nodiscard]] EventRing<kEventCapacity>& events() { return events_; }
   /// Whether this task has entered ERROR at least once. Any thread.
   [[nodiscard]] bool ever_in_error() const noexcept { return ever_in_error_.load(std::memory_order_relaxed); }
