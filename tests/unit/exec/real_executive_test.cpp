@@ -35,10 +35,10 @@ TEST(RealExecutive, RunsSignalsAndStopsCleanly) {
   EXPECT_GT(snap[0].stats.cycles, 10u) << "the task cycles on its own thread";
   ASSERT_TRUE(s->signal("c", Signal::kOff).ok());
   const auto frozen = s->get("count")->at(0);
-  s->run_for(20 * kMs);
+  s->run_for(200 * kMs);
   EXPECT_EQ(s->get("count")->at(0), frozen) << "an OFF task does not cycle";
   ASSERT_TRUE(s->signal("c", Signal::kOn).ok());
-  s->run_for(20 * kMs);
+  s->run_for(200 * kMs);
   EXPECT_GT(s->get("count")->at(0), frozen);
   s->stop();
   EXPECT_EQ(testing::calls()["p"][testing::kOff], 1);
@@ -50,9 +50,9 @@ TEST(RealExecutive, AFailingTaskGoesToErrorAndTheOtherRunsOn) {
       "  - {name: c, module: counter, period: 2ms}\n"
       "  - {name: p, module: probe, period: 2ms, params: {fail: cycle, fail_after: 3}}\n");
   ASSERT_TRUE(s->start().ok());
-  s->run_for(60 * kMs);
+  s->run_for(200 * kMs);
   const auto before = s->get("count")->at(0);
-  s->run_for(20 * kMs);
+  s->run_for(200 * kMs);
   auto snap = s->snapshot();
   EXPECT_EQ(snap[1].state, TaskState::kError);
   EXPECT_EQ(snap[1].stats.cycles, 4u);
