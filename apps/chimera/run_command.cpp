@@ -144,6 +144,9 @@ class Session {
 }  // namespace
 
 int run_command(const RunArgs& args) {
+  // First of all: a signal that arrives while the file loads or the tasks start must still end
+  // in a clean stop (right after start), never in the default action's abrupt exit.
+  install_stop_handlers();
   const Registry& registry = Registry::global();
   auto spec = load_file(args.file, args.config);
   if (!spec) return kExitInvalid;
@@ -164,7 +167,6 @@ int run_command(const RunArgs& args) {
   }
   Subsystem& subsystem = **created;
 
-  install_stop_handlers();
   if (auto started = subsystem.start(); !started) {
     fmt::print(stderr, "{}\n", started.error().message);
     subsystem.stop();  // start() already undid its work; this also removes the shared memory
