@@ -47,6 +47,7 @@ bool values_agree(const std::vector<KnownValue>& values) {
 std::uint32_t count_of(const PortDecl& port, const ResolvedTask& t, const ValueBook& book,
                        std::set<std::string>& size_variables, std::vector<Violation>& violations) {
   const Dim& dim = port.dim;
+  if (dim.follows) return 0;  // fixed later from the variable's other ends (fill_followers)
   if (dim.symbol.empty()) return dim.factor;
   const auto& ports = t.decls.ports();
   const auto sym = std::find_if(ports.begin(), ports.end(),
@@ -82,6 +83,38 @@ std::uint32_t count_of(const PortDecl& port, const ResolvedTask& t, const ValueB
     return 0;
   }
   return dim.factor * static_cast<std::uint32_t>(n);
+}
+
+// Ports declared Dim::follow() take the count that the other ends of their variable fix (a sized
+// port of any task of the file, or `constants:`). A variable that only followers use has no size
+// anywhere: a file-wide violation naming the ports.
+void fill_followers(Resolution& out) {
+  std::map<std::string, std::uint32_t> counts;
+  for (const auto& [name, value] : out.subsystem.spec->constants)
+    counts.try_emplace(name, static_cast<std::uint32_t>(value.size()));
+  for (const auto& t : out.subsystem.tasks)
+    for (std::size_t i = 0; i < t.bindings.size(); ++i)
+      if (!t.decls.ports()[i].dim.follows && t.bindings[i].shape.count != 0)
+        counts.try_emplace(t.bindings[i].variable, t.bindings[i].shape.count);
+  for (auto& t : out.subsystem.tasks) {
+    for (std::size_t i = 0; i < t.bindings.size(); ++i) {
+      if (!t.decls.ports()[i].dim.follows) continue;
+      PortBinding& b = t.bindings[i];
+      const auto known = counts.find(b.variable);
+      if (known != counts.end()) {
+        b.shape.count = known->second;
+        continue;
+      }
+      t.sized = false;
+      out.violations.push_back({3,
+                                {},
+                                b.variable,
+                                {t.spec->name},
+                                fmt::format("rule 3: port {} of task {} takes its size from variable {}, but no other "
+                                            "task or constant of the file gives {} a size",
+                                            b.port, t.spec->name, b.variable, b.variable)});
+    }
+  }
 }
 
 // Where a variable's shape was first seen, for the one-shape-per-variable check.
@@ -179,6 +212,7 @@ Resolution resolve_subsystem(const SubsystemSpec& spec, const Registry& registry
          fmt::format("rule 3: {} sizes ports but has different values in the file: {}", variable, join_names(parts))});
   }
 
+  fill_followers(out);
   collect_variables(out);
   return out;
 }

@@ -14,16 +14,20 @@
 namespace chimera {
 
 /// An element count: `factor` alone, or `factor` times the value of the in-const `symbol`
-/// (its first element), e.g. Dim::of("ndof", 6) for a 6 x ndof Jacobian.
+/// (its first element), e.g. Dim::of("ndof", 6) for a 6 x ndof Jacobian; or, for generic modules
+/// such as a join or a logger, whatever size the other ends of the port's variable give it.
 struct Dim {
   std::uint32_t factor = 1;
-  std::string symbol;  // empty: a fixed count
+  std::string symbol;    // empty: a fixed count
+  bool follows = false;  // true: the size of the variable as another task or `constants:` fixes it
 
-  static Dim fixed(std::uint32_t n) { return Dim{n, {}}; }
-  static Dim of(std::string symbol, std::uint32_t factor = 1) { return Dim{factor, std::move(symbol)}; }
+  static Dim fixed(std::uint32_t n) { return Dim{n, {}, false}; }
+  static Dim of(std::string symbol, std::uint32_t factor = 1) { return Dim{factor, std::move(symbol), false}; }
+  /// The size of the bound variable, fixed by a port of another task (or `constants:`) in the file.
+  static Dim follow() { return Dim{1, {}, true}; }
 };
 
-/// "6", "ndof", "6*ndof".
+/// "6", "ndof", "6*ndof", "any" (a size that follows the variable).
 std::string to_string(const Dim& d);
 
 struct PortDecl {

@@ -97,6 +97,10 @@ inline Registry make_test_registry() {
     d.out_var("out", n, "weighted average");
     d.param("inputs", 2.0, "", "number of inputs");
   });
+  // A generic consumer whose port takes the size its variable has elsewhere in the file.
+  add_fake(r, "any_logger", [](Declarations& d, const Params&) {
+    d.in_var("theta_m", Dim::follow(), "anything, as sized by its producer");
+  });
   add_fake(r, "f32_logger", [](Declarations& d, const Params&) {
     d.in_var<float>("theta_m", Dim::fixed(6), "joint positions, single precision");
   });

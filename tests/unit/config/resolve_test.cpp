@@ -175,6 +175,35 @@ TEST(ResolveSubsystem, ASizeByAPortTheModuleDoesNotHave) {
             "task b: module bad_sized sizes port y by missing_symbol, which is not one of its const ports");
 }
 
+TEST(ResolveSubsystem, AFollowingPortTakesTheSizeItsProducerGives) {
+  const CheckedFile f(R"(subsystem: s
+tasks:
+  - {name: robot, module: robot_position, params: {dof: 7}}
+  - {name: log, module: any_logger}
+configurations:
+  logging: [robot, log]
+)");
+  EXPECT_TRUE(f.resolution().violations.empty()) << testing::PrintToString(messages(f.resolution().violations));
+  EXPECT_TRUE(f.resolved().find_task("log")->sized);
+  EXPECT_EQ(f.binding("log", "theta_m").shape, f64(7));
+}
+
+TEST(ResolveSubsystem, AFollowingPortTakesAConstantsSize) {
+  const CheckedFile f("subsystem: s\nconstants: { theta_m: [1, 2, 3] }\ntasks:\n  - {name: log, module: any_logger}\n");
+  EXPECT_TRUE(f.resolution().violations.empty()) << testing::PrintToString(messages(f.resolution().violations));
+  EXPECT_EQ(f.binding("log", "theta_m").shape, f64(3));
+}
+
+TEST(ResolveSubsystem, AFollowingPortWithNothingToFollow) {
+  const CheckedFile f("subsystem: s\ntasks:\n  - {name: log, module: any_logger}\n");
+  EXPECT_FALSE(f.resolved().find_task("log")->sized);
+  ASSERT_EQ(f.resolution().violations.size(), 1U);
+  EXPECT_EQ(f.resolution().violations[0].rule, 3);
+  EXPECT_EQ(f.resolution().violations[0].message,
+            "rule 3: port theta_m of task log takes its size from variable theta_m, but no other task or constant of "
+            "the file gives theta_m a size");
+}
+
 TEST(ResolveSubsystem, AHandBuiltSpecWithAnUnknownModule) {
   SubsystemSpec spec;
   spec.name = "s";
