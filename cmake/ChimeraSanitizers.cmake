@@ -8,4 +8,5 @@ if(CHIMERA_SANITIZE)
   string(APPEND CMAKE_CXX_FLAGS " ${_san}")
   string(APPEND CMAKE_EXE_LINKER_FLAGS " -fsanitize=${CHIMERA_SANITIZE}")
   string(APPEND CMAKE_SHARED_LINKER_FLAGS " -fsanitize=${CHIMERA_SANITIZE}")
+  string(APPEND CMAKE_MODULE_LINKER_FLAGS " -fsanitize=${CHIMERA_SANITIZE}")  # libraries loaded with dlopen
 endif()

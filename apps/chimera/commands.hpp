@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "chimera/exec/subsystem.hpp"
 
@@ -28,8 +29,17 @@ int run_command(const RunArgs& args);
 
 struct ModulesArgs {
   std::optional<std::string> name;
+  std::vector<std::string> plugins;  // --plugin LIB, loaded besides every library on CHIMERA_MODULE_PATH
 };
-/// `chimera modules [NAME]`; returns the exit code.
+/// `chimera modules [NAME] [--plugin LIB]...`; returns the exit code.
 int modules_command(const ModulesArgs& args);
+
+struct NewModuleArgs {
+  std::string name;
+  bool c = false;         // --lang c: the C template
+  std::string dir = ".";  // where the module's folder goes
+};
+/// `chimera new-module NAME [--lang cpp|c] [--dir DIR]`; returns the exit code.
+int new_module_command(const NewModuleArgs& args);
 
 }  // namespace chimera::cli

@@ -8,9 +8,9 @@
 
 namespace chimera::cli {
 
-/// Loads `file` against the global registry and checks that `config`, if given, names one of
-/// its configurations. On a problem prints the one message to stderr and returns nothing (the
-/// caller exits with kExitInvalid).
+/// Loads the module libraries of `file`'s `plugins:` list, then `file` against the global
+/// registry, and checks that `config`, if given, names one of its configurations. On a problem prints the one message
+/// to stderr and returns nothing (the caller exits with kExitInvalid).
 std::optional<SubsystemSpec> load_file(const std::string& file, const std::optional<std::string>& config);
 
 }  // namespace chimera::cli

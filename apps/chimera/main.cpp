@@ -69,6 +69,18 @@ int run_main(int argc, char** argv) {
   std::string modules_name;
   auto* modules_cmd = app.add_subcommand("modules", "List the module library, or one module's ports and parameters");
   auto* modules_name_opt = modules_cmd->add_option("NAME", modules_name, "a module type");
+  modules_cmd->add_option("--plugin", modules.plugins,
+                          "also load this module library (a path, or a name on CHIMERA_MODULE_PATH); repeatable");
+
+  chimera::cli::NewModuleArgs new_module;
+  std::string new_module_lang = "cpp";
+  auto* new_module_cmd =
+      app.add_subcommand("new-module", "Write a folder with a module library to build outside the tree and load");
+  new_module_cmd->add_option("NAME", new_module.name, "the module's name (lower case, digits, _)")->required();
+  new_module_cmd->add_option("--lang", new_module_lang, "cpp or c")
+      ->check(CLI::IsMember({"cpp", "c"}))
+      ->capture_default_str();
+  new_module_cmd->add_option("--dir", new_module.dir, "where to create the folder NAME/")->capture_default_str();
 
   try {
     app.parse(argc, argv);
@@ -88,6 +100,10 @@ int run_main(int argc, char** argv) {
     if (run_stats_opt->count() > 0) run.stats_json = run_stats;
     run.clock = run_clock == "virtual" ? chimera::ClockKind::kVirtual : chimera::ClockKind::kReal;
     return chimera::cli::run_command(run);
+  }
+  if (new_module_cmd->parsed()) {
+    new_module.c = new_module_lang == "c";
+    return chimera::cli::new_module_command(new_module);
   }
   if (modules_name_opt->count() > 0) modules.name = modules_name;
   return chimera::cli::modules_command(modules);

@@ -1,14 +1,17 @@
-// chimera modules [NAME]: the module library, or one module's ports, parameters and docs.
+// chimera modules [NAME] [--plugin LIB]...: the module library (with every module library on
+// CHIMERA_MODULE_PATH and those given), or one module's ports, parameters and docs.
 
 #include <algorithm>
 #include <cstdio>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
 #include "chimera/control/text_table.hpp"
+#include "chimera/module/plugin_loader.hpp"
 #include "chimera/module/registry.hpp"
 #include "commands.hpp"
 #include "exit_codes.hpp"
@@ -53,17 +56,50 @@ std::string wrap(std::string_view text, std::size_t width) {
   return out;
 }
 
+// Every library on CHIMERA_MODULE_PATH, then those of --plugin; the first problem is printed.
+bool load_plugins(const std::vector<std::string>& extra) {
+  const std::vector<std::string> search_path = module_search_path();
+  for (const auto& file : plugins_on_path(search_path)) {
+    if (auto loaded = load_plugin(file, file); !loaded) {
+      fmt::print(stderr, "CHIMERA_MODULE_PATH: {}\n", loaded.error().message);
+      return false;
+    }
+  }
+  for (const auto& name : extra) {
+    auto found = find_plugin(name, search_path, ".");
+    auto loaded = found ? load_plugin(name, *found) : Result<LoadedPlugin>(found.error());
+    if (!loaded) {
+      fmt::print(stderr, "--plugin: {}\n", loaded.error().message);
+      return false;
+    }
+  }
+  return true;
+}
+
 void print_list(const Registry& registry) {
-  TextTable table({{"module", Align::kLeft}, {"summary", Align::kLeft}});
-  for (const ModuleInfo* m : registry.list()) table.add_row({m->name, m->summary});
+  const auto modules = registry.list();
+  const bool any_plugin = std::any_of(modules.begin(), modules.end(),
+                                      [&](const ModuleInfo* m) { return !registry.origin(m->name).empty(); });
+  if (!any_plugin) {
+    TextTable table({{"module", Align::kLeft}, {"summary", Align::kLeft}});
+    for (const ModuleInfo* m : modules) table.add_row({m->name, m->summary});
+    fmt::print("{}", table.render());
+    return;
+  }
+  TextTable table({{"module", Align::kLeft}, {"summary", Align::kLeft}, {"library", Align::kLeft}});
+  for (const ModuleInfo* m : modules) {
+    const std::string_view origin = registry.origin(m->name);
+    table.add_row({m->name, m->summary, origin.empty() ? std::string("(built in)") : std::string(origin)});
+  }
   fmt::print("{}", table.render());
 }
 
-void print_module(const ModuleInfo& m) {
+void print_module(const ModuleInfo& m, std::string_view origin) {
   // Ports may depend on parameters; the defaults show the usual shape (sizes stay symbolic).
   const Declarations decls = m.declarations(Params{});
 
   fmt::print("{}: {}\n", m.name, m.summary);
+  if (!origin.empty()) fmt::print("library: {}\n", origin);
   if (!m.doc.empty()) fmt::print("\n{}\n", wrap(m.doc, kTextWidth));
   if (!decls.resource().empty()) fmt::print("\nresource: {}\n", decls.resource());
 
@@ -103,6 +139,7 @@ void print_module(const ModuleInfo& m) {
 }  // namespace
 
 int modules_command(const ModulesArgs& args) {
+  if (!load_plugins(args.plugins)) return kExitInvalid;
   const Registry& registry = Registry::global();
   if (!args.name) {
     print_list(registry);
@@ -113,7 +150,7 @@ int modules_command(const ModulesArgs& args) {
     fmt::print(stderr, "unknown module '{}' (chimera modules lists them)\n", *args.name);
     return kExitInvalid;
   }
-  print_module(*module);
+  print_module(*module, registry.origin(module->name));
   return kExitOk;
 }
 

@@ -73,16 +73,17 @@ Result<void> read_cpus(const Source& source, const MapReader& top, SubsystemSpec
   return {};
 }
 
-Result<void> read_plugins(const Source& source, const MapReader& top, std::vector<std::string>& plugins) {
+Result<void> read_plugins(const Source& source, const MapReader& top, std::vector<PluginRef>& plugins) {
   const auto f = top.get("plugins");
   if (!f || f->node.IsNull()) return {};
   if (!f->node.IsSequence())
     return source.fail(*f, fmt::format("must be a list of library names, e.g. [libmy_modules.so], not {}",
                                        config_detail::describe(f->node)));
   for (std::size_t i = 0; i < f->node.size(); ++i) {
-    auto name = config_detail::read_text(source, element(*f, i, f->node[i]));
+    const Field e = element(*f, i, f->node[i]);
+    auto name = config_detail::read_text(source, e);
     if (!name) return name.error();
-    plugins.push_back(*std::move(name));
+    plugins.push_back(PluginRef{*std::move(name), e.line, e.path});
   }
   return {};
 }
@@ -203,7 +204,9 @@ Result<SubsystemSpec> load(const Source& source, std::string_view text, const Re
   if (auto ok = read_name(source, *top, spec); !ok) return ok.error();
   if (auto ok = read_scheduler(source, *top, spec); !ok) return ok.error();
   if (auto ok = read_cpus(source, *top, spec); !ok) return ok.error();
-  if (auto ok = read_plugins(source, *top, spec.plugins); !ok) return ok.error();
+  std::vector<PluginRef> plugins;
+  if (auto ok = read_plugins(source, *top, plugins); !ok) return ok.error();
+  for (auto& p : plugins) spec.plugins.push_back(std::move(p.name));
   if (auto ok = read_constants(source, *top, spec); !ok) return ok.error();
   if (auto ok = read_tasks(source, *top, registry, spec); !ok) return ok.error();
   if (auto ok = read_configurations(source, *top, spec); !ok) return ok.error();
@@ -247,12 +250,12 @@ Result<SubsystemSpec> load_subsystem_file(const std::string& path, const Registr
   return load_subsystem_text(*text, path, registry);
 }
 
-Result<std::vector<std::string>> read_plugin_names_text(std::string_view text, const std::string& file_name) {
+Result<std::vector<PluginRef>> read_plugin_names_text(std::string_view text, const std::string& file_name) {
   const Source source(file_name);
   try {
     auto top = read_document(source, text);
     if (!top) return top.error();
-    std::vector<std::string> plugins;
+    std::vector<PluginRef> plugins;
     if (auto ok = read_plugins(source, *top, plugins); !ok) return ok.error();
     return plugins;
   } catch (const YAML::Exception& e) {
@@ -260,7 +263,7 @@ Result<std::vector<std::string>> read_plugin_names_text(std::string_view text, c
   }
 }
 
-Result<std::vector<std::string>> read_plugin_names_file(const std::string& path) {
+Result<std::vector<PluginRef>> read_plugin_names_file(const std::string& path) {
   auto text = read_file(path);
   if (!text) return text.error();
   return read_plugin_names_text(*text, path);

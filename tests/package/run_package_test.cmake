@@ -1,37 +1,25 @@
 # cmake -DBUILD_DIR=... -DCONSUMER_DIR=... -DWORK_DIR=... -DGENERATOR=... -DCXX_COMPILER=... -P run_package_test.cmake
 # Installs BUILD_DIR into WORK_DIR/prefix, builds the consumer against it, runs it, checks its output.
 cmake_minimum_required(VERSION 3.25)
-foreach(var BUILD_DIR CONSUMER_DIR WORK_DIR GENERATOR CXX_COMPILER)
-  if(NOT DEFINED ${var})
-    message(FATAL_ERROR "run_package_test.cmake: -D${var}=... is required")
-  endif()
-endforeach()
+include(${CMAKE_CURRENT_LIST_DIR}/steps.cmake)
+require_definitions(run_package_test.cmake BUILD_DIR CONSUMER_DIR WORK_DIR GENERATOR CXX_COMPILER)
 
 set(prefix ${WORK_DIR}/prefix)
 set(consumer_build ${WORK_DIR}/consumer-build)
 file(REMOVE_RECURSE ${WORK_DIR})
 file(MAKE_DIRECTORY ${WORK_DIR})
 
-function(step what)
-  message(STATUS "package test: ${what}")
-  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE out)
-  if(NOT rc EQUAL 0)
-    message(FATAL_ERROR "package test: ${what} failed (${rc}):\n${out}")
-  endif()
-  set(step_output "${out}" PARENT_SCOPE)
-endfunction()
-
-step("install ${BUILD_DIR} into ${prefix}" ${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${prefix})
+step("package test: install ${BUILD_DIR} into ${prefix}" ${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${prefix})
 # Only the installed package may be found: no package registry, no system-wide chimera.
-step("configure the consumer" ${CMAKE_COMMAND} -S ${CONSUMER_DIR} -B ${consumer_build} -G ${GENERATOR}
+step("package test: configure the consumer" ${CMAKE_COMMAND} -S ${CONSUMER_DIR} -B ${consumer_build} -G ${GENERATOR}
      -DCMAKE_CXX_COMPILER=${CXX_COMPILER} -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF
      -DCMAKE_FIND_USE_SYSTEM_PACKAGE_REGISTRY=OFF -DCMAKE_BUILD_TYPE=RelWithDebInfo)
 file(STRINGS ${consumer_build}/CMakeCache.txt chimera_dir REGEX "^chimera_DIR:")
 if(NOT chimera_dir MATCHES "^chimera_DIR:PATH=${prefix}/")
   message(FATAL_ERROR "package test: the consumer found chimera outside ${prefix}: ${chimera_dir}")
 endif()
-step("build the consumer" ${CMAKE_COMMAND} --build ${consumer_build})
-step("run the consumer" ${consumer_build}/consumer)
+step("package test: build the consumer" ${CMAKE_COMMAND} --build ${consumer_build})
+step("package test: run the consumer" ${consumer_build}/consumer)
 message(STATUS "consumer said:\n${step_output}")
 
 foreach(expected

@@ -26,11 +26,19 @@ Result<SubsystemSpec> load_subsystem_file(const std::string& path, const Registr
 Result<SubsystemSpec> load_subsystem_text(std::string_view text, const std::string& file_name,
                                           const Registry& registry);
 
+/// One entry of a subsystem file's `plugins:` list, with where it is written.
+struct PluginRef {
+  std::string name;  // as written: a library file name, or a path
+  int line = 0;
+  std::string key;  // "plugins[0]"
+};
+
 /// Only the `plugins:` list of a subsystem file, so that a caller can load the module libraries
-/// it names before load_subsystem_file() checks the tasks' modules against the registry.
+/// it names before load_subsystem_file() checks the tasks' modules against the registry
+/// (load_file_plugins() in chimera/config/plugins.hpp does both steps for a file).
 /// Errors carry Errc::kInvalidInput. Not real-time safe.
-Result<std::vector<std::string>> read_plugin_names_file(const std::string& path);
+Result<std::vector<PluginRef>> read_plugin_names_file(const std::string& path);
 /// The same for text already in memory; `file_name` is used in messages.
-Result<std::vector<std::string>> read_plugin_names_text(std::string_view text, const std::string& file_name);
+Result<std::vector<PluginRef>> read_plugin_names_text(std::string_view text, const std::string& file_name);
 
 }  // namespace chimera

@@ -40,9 +40,32 @@ class Registry {
   [[nodiscard]] const ModuleInfo* find(std::string_view name) const;
   /// Sorted by name.
   [[nodiscard]] std::vector<const ModuleInfo*> list() const;
+  /// The library module `name` was loaded from; "" for a module linked into the program.
+  [[nodiscard]] std::string_view origin(std::string_view name) const;
+
+  /// What happened to registrations between begin_capture() and end_capture(): the plugin
+  /// loader brackets a library's loading with them to learn what the library brought.
+  struct Capture {
+    std::vector<std::string> added;    // module names, in registration order
+    std::vector<std::string> refused;  // one message per refused registration
+  };
+  /// Modules added from now on come from `origin` (a library's path), and refusals are kept.
+  void begin_capture(std::string origin);
+  Capture end_capture();
+  /// Records a registration refused before it reached add() (a C module of another ABI, say).
+  void refuse(std::string message);
+  /// Removes module `name` (a library that failed its checks takes its modules back).
+  void remove(std::string_view name);
 
  private:
-  std::vector<std::unique_ptr<ModuleInfo>> modules_;
+  struct Entry {
+    std::unique_ptr<ModuleInfo> info;
+    std::string origin;
+  };
+  std::vector<Entry> modules_;
+  bool capturing_ = false;
+  std::string origin_;
+  Capture capture_;
 };
 
 namespace detail {

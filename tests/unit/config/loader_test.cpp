@@ -222,7 +222,10 @@ TEST(ReadPluginNames, ReadsOnlyThePluginList) {
   auto r = read_plugin_names_text("subsystem: s\nplugins: [liba.so]\ntasks:\n  - {name: a, module: from_plugin}\n",
                                   "p.yaml");
   ASSERT_TRUE(r.ok()) << r.error().message;
-  EXPECT_EQ(*r, (std::vector<std::string>{"liba.so"}));
+  ASSERT_EQ(r->size(), 1u);
+  EXPECT_EQ((*r)[0].name, "liba.so");
+  EXPECT_EQ((*r)[0].line, 2);
+  EXPECT_EQ((*r)[0].key, "plugins[0]");
   auto none = read_plugin_names_file(kData + "/figure4.yaml");
   ASSERT_TRUE(none.ok()) << none.error().message;
   EXPECT_TRUE(none->empty());

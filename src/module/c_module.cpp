@@ -1,0 +1,212 @@
+// The C interface of include/chimera/module/c_module.h: a C module is a struct of function
+// pointers, and CModule is the one C++ module that calls them. The opaque C handles wrap the C++
+// objects: chimera_decl a Declarations, chimera_params a Params, chimera_ctx a task's context.
+
+#include "chimera/module/c_module.h"
+
+#include <cstddef>
+#include <deque>
+#include <memory>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "chimera/module/registry.hpp"
+
+struct chimera_decl {
+  chimera::Declarations* decls;
+};
+
+struct chimera_params {
+  const chimera::Params* params;
+};
+
+// The context a C module's methods see, from init until kill.
+struct chimera_ctx {
+  chimera::InitContext* init = nullptr;  // only while init runs: ports are bound then
+  chimera_params params{nullptr};
+  std::string task_name;
+  const chimera::CycleTiming* source = nullptr;
+  const chimera::SubsystemFlags* flags = nullptr;
+  chimera_timing timing{};
+  std::deque<chimera::In<double>> inputs;  // a deque: chimera_in::port_ points at its elements
+};
+
+namespace {
+
+using chimera::Declarations;
+using chimera::Params;
+using chimera::Status;
+
+static_assert(static_cast<int>(chimera::Freshness::kNoData) == CHIMERA_NO_DATA);
+static_assert(static_cast<int>(chimera::Freshness::kOld) == CHIMERA_OLD);
+static_assert(static_cast<int>(chimera::Freshness::kNew) == CHIMERA_NEW);
+
+Declarations& decl_of(chimera_decl* d) { return *d->decls; }
+const Params& params_of(const chimera_params* p) { return *p->params; }
+
+std::string text_or_empty(const char* s) { return s != nullptr ? std::string(s) : std::string(); }
+
+chimera::Dim dim_of(chimera_dim d) { return chimera::Dim{d.factor, text_or_empty(d.symbol), d.follows != 0}; }
+
+Status status_of(chimera_status s) { return s == CHIMERA_OK ? Status::ok() : Status::fail(s); }
+
+class CModule final : public chimera::Module {
+ public:
+  explicit CModule(const chimera_c_module& def)
+      : def_(def), state_((def.state_size + sizeof(std::max_align_t) - 1) / sizeof(std::max_align_t)) {}
+
+ protected:
+  Status init(chimera::InitContext& ctx) override {
+    ctx_.init = &ctx;
+    ctx_.params.params = &ctx.params();
+    ctx_.task_name = std::string(ctx.task_name());
+    ctx_.source = &ctx.timing();
+    ctx_.flags = &ctx.flags();
+    refresh_timing();
+    const Status s = def_.init != nullptr ? status_of(def_.init(state(), &ctx_)) : Status::ok();
+    ctx_.init = nullptr;
+    return s;
+  }
+  Status on() override { return call(def_.on); }
+  Status cycle() override { return call(def_.cycle); }
+  Status off() override { return call(def_.off); }
+  Status kill() override { return call(def_.kill); }
+  Status error() override {
+    return def_.error != nullptr ? call(def_.error) : Status::fail("module has no error handler");
+  }
+  Status clear() override { return call(def_.clear); }
+  Status reinit() override { return call(def_.reinit); }
+  Status sync() override { return call(def_.sync); }
+
+ private:
+  using Method = chimera_status (*)(void*);
+
+  // Real-time safe: three words copied, one indirect call.
+  Status call(Method method) noexcept {
+    if (method == nullptr) return Status::ok();
+    refresh_timing();
+    return status_of(method(state()));
+  }
+  void refresh_timing() noexcept {
+    ctx_.timing = chimera_timing{ctx_.source->release_ns, ctx_.source->period_ns, ctx_.source->cycle};
+  }
+  void* state() noexcept { return state_.empty() ? nullptr : state_.data(); }
+
+  const chimera_c_module& def_;
+  std::vector<std::max_align_t> state_;  // zeroed, aligned for anything the module keeps there
+  chimera_ctx ctx_;
+};
+
+}  // namespace
+
+extern "C" {
+
+void chimera_in_const(chimera_decl* d, const char* name, chimera_dim dim, const char* doc) {
+  decl_of(d).in_const<double>(text_or_empty(name), dim_of(dim), text_or_empty(doc));
+}
+void chimera_in_var(chimera_decl* d, const char* name, chimera_dim dim, const char* doc) {
+  decl_of(d).in_var<double>(text_or_empty(name), dim_of(dim), text_or_empty(doc));
+}
+void chimera_out_var(chimera_decl* d, const char* name, chimera_dim dim, const char* doc) {
+  decl_of(d).out_var<double>(text_or_empty(name), dim_of(dim), text_or_empty(doc));
+}
+void chimera_out_const(chimera_decl* d, const char* name, const double* values, size_t count, const char* doc) {
+  std::vector<double> v;
+  if (values != nullptr) v.assign(values, values + count);
+  decl_of(d).out_const(text_or_empty(name), std::move(v), text_or_empty(doc));
+}
+void chimera_param_number(chimera_decl* d, const char* name, double value, const char* unit, const char* doc) {
+  decl_of(d).param(text_or_empty(name), value, text_or_empty(unit), text_or_empty(doc));
+}
+void chimera_param_bool(chimera_decl* d, const char* name, int value, const char* unit, const char* doc) {
+  decl_of(d).param(text_or_empty(name), value != 0, text_or_empty(unit), text_or_empty(doc));
+}
+void chimera_param_string(chimera_decl* d, const char* name, const char* value, const char* unit, const char* doc) {
+  decl_of(d).param(text_or_empty(name), text_or_empty(value), text_or_empty(unit), text_or_empty(doc));
+}
+void chimera_param_vector(chimera_decl* d, const char* name, const double* values, size_t count, const char* unit,
+                          const char* doc) {
+  chimera::Vector v;
+  if (values != nullptr) v.assign(values, values + count);
+  decl_of(d).param(text_or_empty(name), std::move(v), text_or_empty(unit), text_or_empty(doc));
+}
+void chimera_resource(chimera_decl* d, const char* what) { decl_of(d).resource(text_or_empty(what)); }
+
+double chimera_number(const chimera_params* p, const char* name, double fallback) {
+  return name != nullptr ? params_of(p).number(name, fallback) : fallback;
+}
+int chimera_flag(const chimera_params* p, const char* name, int fallback) {
+  return name != nullptr ? static_cast<int>(params_of(p).flag(name, fallback != 0)) : fallback;
+}
+const char* chimera_text(const chimera_params* p, const char* name) {
+  if (name == nullptr) return nullptr;
+  const chimera::ParamValue* v = params_of(p).find(name);
+  const auto* text = v != nullptr ? std::get_if<std::string>(v) : nullptr;
+  return text != nullptr ? text->c_str() : nullptr;
+}
+size_t chimera_vector(const chimera_params* p, const char* name, double* out, size_t capacity) {
+  if (name == nullptr) return 0;
+  const chimera::ParamValue* v = params_of(p).find(name);
+  const auto* vec = v != nullptr ? std::get_if<chimera::Vector>(v) : nullptr;
+  if (vec == nullptr) return 0;
+  for (size_t i = 0; i < vec->size() && i < capacity && out != nullptr; ++i) out[i] = (*vec)[i];
+  return vec->size();
+}
+
+chimera_in chimera_input(chimera_ctx* ctx, const char* port) {
+  if (ctx->init == nullptr || port == nullptr) return chimera_in{nullptr, 0, nullptr};
+  const chimera::In<double> in = ctx->init->in<double>(port);  // a bad port makes init fail, naming it
+  if (!in.bound()) return chimera_in{nullptr, 0, nullptr};
+  ctx->inputs.push_back(in);
+  return chimera_in{in.values().data(), in.size(), &ctx->inputs.back()};
+}
+chimera_out chimera_output(chimera_ctx* ctx, const char* port) {
+  if (ctx->init == nullptr || port == nullptr) return chimera_out{nullptr, 0};
+  const chimera::Out<double> out = ctx->init->out<double>(port);
+  return chimera_out{out.bound() ? out.values().data() : nullptr, out.size()};
+}
+chimera_freshness chimera_fresh(chimera_in in) {
+  if (in.port_ == nullptr) return CHIMERA_NO_DATA;
+  return static_cast<chimera_freshness>(static_cast<const chimera::In<double>*>(in.port_)->freshness());
+}
+
+const chimera_params* chimera_ctx_params(const chimera_ctx* ctx) { return &ctx->params; }
+const char* chimera_task_name(const chimera_ctx* ctx) { return ctx->task_name.c_str(); }
+const chimera_timing* chimera_timing_of(const chimera_ctx* ctx) { return &ctx->timing; }
+double chimera_period_s(const chimera_ctx* ctx) { return static_cast<double>(ctx->timing.period_ns) * 1e-9; }
+int chimera_illegal_configuration(const chimera_ctx* ctx) {
+  return static_cast<int>(ctx->flags->illegal_configuration());
+}
+
+void chimera_register_c_module(const chimera_c_module* module) {
+  chimera::Registry& registry = chimera::Registry::global();
+  if (module == nullptr) {
+    registry.refuse("chimera_register_c_module was given NULL");
+    return;
+  }
+  const std::string name = text_or_empty(module->name);
+  if (module->abi_version != CHIMERA_C_ABI_VERSION) {
+    // Only the first two fields are read: they keep their place in every version.
+    registry.refuse(fmt::format("C module '{}' was built for C ABI version {}, but this chimera has version {}", name,
+                                module->abi_version, CHIMERA_C_ABI_VERSION));
+    return;
+  }
+  if (name.empty() || module->declare == nullptr) {
+    registry.refuse(fmt::format("C module '{}' has no {}", name, name.empty() ? "name" : "declare function"));
+    return;
+  }
+  const chimera_c_module* def = module;
+  (void)registry.add(
+      chimera::ModuleInfo{name, text_or_empty(module->summary), text_or_empty(module->doc),
+                          [def](Declarations& d, const Params& p) {
+                            chimera_decl decl{&d};
+                            const chimera_params params{&p};
+                            def->declare(&decl, &params);
+                          },
+                          [def]() -> std::unique_ptr<chimera::Module> { return std::make_unique<CModule>(*def); }});
+}
+
+}  // extern "C"
