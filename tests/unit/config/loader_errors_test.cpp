@@ -172,7 +172,8 @@ tasks:
 
 TEST(LoaderErrors, UnknownModule) {
   EXPECT_EQ(error_of("subsystem: s\ntasks:\n  - name: a\n    module: pidd\n"),
-            "pid.yaml:4: tasks[0].module: no module named pidd (known: bad_sized, damped_least_squares, f32_logger, "
+            "pid.yaml:4: tasks[0].module: no module named pidd (known: any_logger, bad_sized, damped_least_squares, "
+            "f32_logger, "
             "fwd_kin_jacobian, inv_kin, join_weighted_average, joint_traj_gen, pid_joint, robot_position, "
             "robot_torque, time_integrator, visual_servo)");
   const Registry empty;
