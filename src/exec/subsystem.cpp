@@ -14,6 +14,7 @@
 #include "chimera/exec/task.hpp"
 #include "real_executive.hpp"
 #include "release_order.hpp"
+#include "schedule_plan.hpp"
 #include "value_codec.hpp"
 #include "virtual_executive.hpp"
 
@@ -45,6 +46,7 @@ struct Subsystem::Impl {
   std::unique_ptr<TableFlags> flags;
   std::vector<std::unique_ptr<Task>> tasks;
   ReleaseOrder order;
+  SchedulePlan plan;
   std::unique_ptr<VirtualExecutive> virtual_exec;
   std::unique_ptr<RealExecutive> real_exec;
   std::vector<std::string> last_error;
@@ -125,11 +127,17 @@ Result<std::unique_ptr<Subsystem>> Subsystem::create(const SubsystemSpec& spec, 
   }
   m.last_error.assign(m.tasks.size(), {});
   m.order = compute_release_order(m.resolution.subsystem);
+  const ConfigurationSpec* start_config = m.spec.find_configuration(m.configuration);
+  m.plan = make_schedule_plan(m.resolution.subsystem, m.order, subsystem_cpus(m.spec), start_config->tasks);
+  for (Task* t : raw) {
+    t->set_virtual_clock(m.options.clock == ClockKind::kVirtual);
+    if (m.options.measure_cpu_time || t->spec().wcet_ns) t->set_exec_clock(Task::ExecClock::kCpu);
+  }
   if (m.options.clock == ClockKind::kVirtual) {
-    m.virtual_exec = std::make_unique<VirtualExecutive>(raw, m.order);
+    m.virtual_exec = std::make_unique<VirtualExecutive>(raw, m.order, m.plan, *m.table);
   } else {
     prepare_realtime_process(m.options.realtime_priorities);
-    m.real_exec = std::make_unique<RealExecutive>(raw, m.order, m.spec, m.options.realtime_priorities);
+    m.real_exec = std::make_unique<RealExecutive>(raw, m.order, m.plan, m.options.realtime_priorities, *m.table);
   }
   return s;
 }
@@ -224,6 +232,7 @@ Result<void> Subsystem::set(std::string_view variable, const std::vector<double>
   auto bytes = encode_values(m.table->shape(*v), values);
   if (!bytes) return bytes.error();
   m.table->write(*v, bytes->data());
+  if (m.real_exec) m.real_exec->variable_written(*v);  // the virtual clock sees the new version itself
   return {};
 }
 
@@ -234,8 +243,8 @@ std::vector<TaskSnapshot> Subsystem::snapshot() const {
   std::vector<TaskSnapshot> out;
   for (std::size_t i = 0; i < m.tasks.size(); ++i) {
     const Task& t = *m.tasks[i];
-    out.push_back(TaskSnapshot{t.name(), t.spec().module, t.state(), t.period_ns(), t.spec().cpu.value_or(-1),
-                               t.stats().snapshot(), m.last_error[i]});
+    out.push_back(TaskSnapshot{t.name(), t.spec().module, t.state(), t.period_ns(), m.plan.cpu[i], t.stats().snapshot(),
+                               m.last_error[i]});
   }
   return out;
 }

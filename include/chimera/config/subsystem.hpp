@@ -15,9 +15,20 @@ namespace chimera {
 
 enum class SchedulerKind { kRm, kDm, kEdf, kMuf };
 enum class Criticality { kHard, kSoft };
+/// What a periodic task does with releases that passed while a cycle ran late: run each of them
+/// late, one after another (the grid holds, each counts as missed if it ends late), or skip
+/// them and go on at the next release still ahead (each skipped release counts as missed).
+enum class LatePolicy { kRun, kSkip };
 
 std::string_view scheduler_name(SchedulerKind s);
 std::string_view criticality_name(Criticality c);
+std::string_view late_policy_name(LatePolicy p);
+
+/// A sporadic server for an aperiodic task: at most `budget_ns` of execution per `period_ns`.
+struct ServerSpec {
+  std::int64_t budget_ns = 0;
+  std::int64_t period_ns = 0;
+};
 
 /// Where something was written: for messages of the form "file:line: key: problem".
 struct SourceLoc {
@@ -29,10 +40,14 @@ struct TaskSpec {
   std::string name;                       // instance name, unique in the file
   std::string module;                     // module type in the registry
   std::optional<std::int64_t> period_ns;  // absent: aperiodic
-  std::int64_t deadline_ns = 0;           // defaults to the period; 0: none (aperiodic, not given)
+  std::int64_t deadline_ns = 0;           // defaults to the period (the server's period); 0: none
   Criticality criticality = Criticality::kHard;
   std::optional<std::int64_t> wcet_ns;
   std::optional<int> cpu;
+  int priority = 0;                    // user priority, MUF's third level: higher is more urgent
+  LatePolicy late = LatePolicy::kRun;  // default: run for hard tasks, skip for soft ones
+  std::int64_t virtual_exec_ns = 0;    // simulated execution time of a cycle on the virtual clock
+  std::optional<ServerSpec> server;    // aperiodic tasks only
   Params params;
   std::map<std::string, std::string> rename;  // port name -> variable name
   SourceLoc loc;

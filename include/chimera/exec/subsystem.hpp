@@ -29,6 +29,9 @@ struct RunOptions {
   std::string shm_suffix;
   /// Ask for SCHED_FIFO and mlockall (real clock); falls back with one warning if refused.
   bool realtime_priorities = true;
+  /// Real clock: measure every task's execution time as its thread's CPU time (profiling), not
+  /// only that of tasks with a wcet budget. Costs two system calls a cycle.
+  bool measure_cpu_time = false;
 };
 
 /// One task as the subsystem interface sees it.
@@ -37,7 +40,7 @@ struct TaskSnapshot {
   std::string module;
   TaskState state = TaskState::kNotCreated;
   std::int64_t period_ns = 0;
-  int cpu = -1;  // -1: not pinned
+  int cpu = 0;  // the CPU it runs on (pinned by the file or assigned)
   TaskStatsSnapshot stats;
   std::string last_error;  // the last method failure, "" if none
 };

@@ -19,7 +19,13 @@ std::vector<TaskSnapshot> sample() {
   pid.module = "pid_joint";
   pid.state = TaskState::kOn;
   pid.period_ns = 1'000'000;
-  pid.stats = {2000, 3, 12'345, 250'000, 800, 40'000, 1'500'000};
+  pid.stats.cycles = 2000;
+  pid.stats.missed = 3;
+  pid.stats.exec_mean_ns = 12'345;
+  pid.stats.exec_max_ns = 250'000;
+  pid.stats.latency_p50_ns = 800;
+  pid.stats.latency_p99_ns = 40'000;
+  pid.stats.latency_max_ns = 1'500'000;
   TaskSnapshot traj;
   traj.name = "traj";
   traj.module = "joint_traj_gen";
