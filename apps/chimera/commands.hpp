@@ -42,4 +42,13 @@ struct NewModuleArgs {
 /// `chimera new-module NAME [--lang cpp|c] [--dir DIR]`; returns the exit code.
 int new_module_command(const NewModuleArgs& args);
 
+struct PlotArgs {
+  std::string log;                    // a data_logger CSV file
+  std::optional<std::string> output;  // default: the log's name with .png
+  std::string variables;              // comma-separated; empty: all
+  std::string title;
+};
+/// `chimera plot LOG.csv [-o OUT.png] [--vars a,b] [--title TEXT]`; returns the exit code.
+int plot_command(const PlotArgs& args);
+
 }  // namespace chimera::cli

@@ -82,6 +82,14 @@ int run_main(int argc, char** argv) {
       ->capture_default_str();
   new_module_cmd->add_option("--dir", new_module.dir, "where to create the folder NAME/")->capture_default_str();
 
+  chimera::cli::PlotArgs plot;
+  std::string plot_output;
+  auto* plot_cmd = app.add_subcommand("plot", "Draw a data_logger log (CSV) as a picture (PNG)");
+  plot_cmd->add_option("LOG", plot.log, "a CSV file written by a data_logger task")->required();
+  auto* plot_output_opt = plot_cmd->add_option("-o,--output", plot_output, "the picture (default: LOG with .png)");
+  plot_cmd->add_option("--vars", plot.variables, "only these variables, comma-separated");
+  plot_cmd->add_option("--title", plot.title, "the picture's title (default: the log's file name)");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -100,6 +108,10 @@ int run_main(int argc, char** argv) {
     if (run_stats_opt->count() > 0) run.stats_json = run_stats;
     run.clock = run_clock == "virtual" ? chimera::ClockKind::kVirtual : chimera::ClockKind::kReal;
     return chimera::cli::run_command(run);
+  }
+  if (plot_cmd->parsed()) {
+    if (plot_output_opt->count() > 0) plot.output = plot_output;
+    return chimera::cli::plot_command(plot);
   }
   if (new_module_cmd->parsed()) {
     new_module.c = new_module_lang == "c";

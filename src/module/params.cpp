@@ -11,6 +11,7 @@ std::string_view param_type_name(ParamType t) {
     case ParamType::kString: return "string";
     case ParamType::kVector: return "list of numbers";
     case ParamType::kMatrix: return "list of lists of numbers";
+    case ParamType::kStringList: return "list of strings";
   }
   return "?";
 }
@@ -35,6 +36,12 @@ std::string to_string(const ParamValue& v) {
       const auto& m = std::get<Matrix>(v);
       std::string out = "[";
       for (std::size_t i = 0; i < m.size(); ++i) out += (i != 0 ? ", " : "") + join_numbers(m[i]);
+      return out + "]";
+    }
+    case ParamType::kStringList: {
+      const auto& list = std::get<StringList>(v);
+      std::string out = "[";
+      for (std::size_t i = 0; i < list.size(); ++i) out += fmt::format("{}\"{}\"", i != 0 ? ", " : "", list[i]);
       return out + "]";
     }
   }
@@ -63,5 +70,8 @@ std::string Params::text(std::string_view name, std::string fallback) const {
 }
 Vector Params::vector(std::string_view name, Vector fallback) const { return get_or(*this, name, std::move(fallback)); }
 Matrix Params::matrix(std::string_view name, Matrix fallback) const { return get_or(*this, name, std::move(fallback)); }
+StringList Params::strings(std::string_view name, StringList fallback) const {
+  return get_or(*this, name, std::move(fallback));
+}
 
 }  // namespace chimera

@@ -1,7 +1,12 @@
 // The real-time path allocates nothing. While an AllocationGuard is armed every allocation is
 // counted and operator new fails by throwing. Cycles of the framework (transfers, statistics,
-// timing, dispatch) and of the Figure 4 modules run armed, on both clocks.
+// timing, dispatch) and of the Figure 4 modules, data logger included, run armed, on both clocks.
 
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -37,6 +42,43 @@ std::uint64_t total_cycles(const Subsystem& s) {
   return n;
 }
 
+// The cycles all periodic tasks run in `ns` of virtual time, each at its own period.
+std::uint64_t cycles_in(const Subsystem& s, std::int64_t ns) {
+  std::uint64_t n = 0;
+  for (const auto& t : s.snapshot())
+    if (t.period_ns > 0) n += static_cast<std::uint64_t>(ns / t.period_ns);
+  return n;
+}
+
+// The subsystem of `text` started on the virtual clock and run 10 ms (first touches); nullptr
+// (and a test failure) if it does not load, create or start.
+std::unique_ptr<Subsystem> started_virtual(const std::string& text) {
+  auto spec = load_subsystem_text(text, "inline.yaml", Registry::global());
+  EXPECT_TRUE(spec.ok()) << (spec.ok() ? "" : spec.error().message);
+  if (!spec.ok()) return nullptr;
+  RunOptions o;
+  o.clock = ClockKind::kVirtual;
+  o.shm_suffix = testing::unique_suffix();
+  auto s = Subsystem::create(*spec, Registry::global(), o);
+  EXPECT_TRUE(s.ok()) << (s.ok() ? "" : s.error().message);
+  if (!s.ok() || !(*s)->start().ok()) return nullptr;
+  (*s)->run_for(10 * kMs);
+  return std::move(*s);
+}
+
+// Allocations in every thread while `s` runs for `ns`, with allocation made to fail.
+long allocations_while_running(Subsystem& s, std::int64_t ns) {
+  AllocationGuard guard(AllocationGuard::OnNew::kFail);
+  s.run_for(ns);
+  return AllocationGuard::count();
+}
+
+bool runs_module(const Subsystem& s, const std::string& module) {
+  for (const auto& t : s.snapshot())
+    if (t.module == module) return true;
+  return false;
+}
+
 TEST(NoAllocationInCycle, Figure4OnTheVirtualClock) {
   auto s = fig4(ClockKind::kVirtual);
   s->run_for(100 * kMs);  // warm up: first touches, lazy initialisation
@@ -48,7 +90,8 @@ TEST(NoAllocationInCycle, Figure4OnTheVirtualClock) {
     allocations = AllocationGuard::count();
   }
   EXPECT_EQ(allocations, 0) << "allocations inside cycles";
-  EXPECT_EQ(total_cycles(*s) - before, s->snapshot().size() * 2000u);
+  EXPECT_EQ(total_cycles(*s) - before, cycles_in(*s, 2000 * kMs));
+  EXPECT_TRUE(runs_module(*s, "data_logger")) << "the example logs its run, and this test covers the logger";
   for (const auto& t : s->snapshot()) EXPECT_EQ(t.state, TaskState::kOn) << t.name;
 }
 
@@ -67,6 +110,32 @@ TEST(NoAllocationInCycle, Figure4OnTheRealClock) {
   for (const auto& t : s->snapshot()) EXPECT_EQ(t.state, TaskState::kOn) << t.name;
 }
 
+// A ring of 16 rows fills at once: on the virtual clock the logger's cycle then waits for its
+// writer thread, and neither allocates (the guard counts every thread).
+TEST(NoAllocationInCycle, TheDataLoggerWithAFullRing) {
+  const std::string log =
+      (std::filesystem::temp_directory_path() / ("chimera_noalloc_" + std::to_string(::getpid()) + ".csv")).string();
+  const std::string text = R"(subsystem: fig4_logged
+tasks:
+  - { name: traj, module: joint_traj_gen, period: 1ms }
+  - { name: pid, module: pid_joint, period: 1ms }
+  - { name: robot, module: robot_torque, period: 1ms }
+  - name: log
+    module: data_logger
+    period: 1ms
+    params: { variables: [theta_d, theta_m, tau_r], capacity: 16, file: )" +
+                           log + " }\n";
+  auto s = started_virtual(text);
+  ASSERT_NE(s, nullptr);
+  EXPECT_EQ(allocations_while_running(*s, 500 * kMs), 0) << "allocations while logging";
+  s->stop();
+  std::ifstream in(log);
+  std::size_t lines = 0;
+  for (std::string line; std::getline(in, line);) ++lines;
+  EXPECT_EQ(lines, 1u + 510u) << "a header and a row for each cycle: none lost, none failed";
+  std::filesystem::remove(log);
+}
+
 TEST(NoAllocationInCycle, Figure4WithSensorNoise) {
   const char* text = R"(subsystem: fig4_noise
 tasks:
@@ -74,23 +143,10 @@ tasks:
   - { name: pid, module: pid_joint, period: 1ms }
   - { name: robot, module: robot_torque, period: 1ms, params: { noise_std: 0.001 } }
 )";
-  auto spec = load_subsystem_text(text, "fig4_noise.yaml", Registry::global());
-  ASSERT_TRUE(spec.ok()) << spec.error().message;
-  RunOptions o;
-  o.clock = ClockKind::kVirtual;
-  o.shm_suffix = testing::unique_suffix();
-  auto s = Subsystem::create(*spec, Registry::global(), o);
-  ASSERT_TRUE(s.ok()) << s.error().message;
-  ASSERT_TRUE((*s)->start().ok());
-  (*s)->run_for(10 * kMs);
-  long allocations = 0;
-  {
-    AllocationGuard guard(AllocationGuard::OnNew::kFail);
-    (*s)->run_for(500 * kMs);
-    allocations = AllocationGuard::count();
-  }
-  EXPECT_EQ(allocations, 0) << "allocations during 500 cycles of each task";
-  EXPECT_EQ(total_cycles(**s), 3u * 510u);
+  auto s = started_virtual(text);
+  ASSERT_NE(s, nullptr);
+  EXPECT_EQ(allocations_while_running(*s, 500 * kMs), 0) << "allocations during 500 cycles of each task";
+  EXPECT_EQ(total_cycles(*s), 3u * 510u);
 }
 
 // The detector detects: a module that allocates in cycle() is caught, and its task goes to ERROR.

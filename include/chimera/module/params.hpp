@@ -1,6 +1,6 @@
 #pragma once
 // A module's in-consts from the subsystem file's `params:` (numbers, flags, text, vectors,
-// matrices), checked against the module's declared parameters when the file is loaded.
+// matrices, lists of text), checked against the module's declared parameters when the file is loaded.
 
 #include <map>
 #include <string>
@@ -10,16 +10,18 @@
 
 namespace chimera {
 
-enum class ParamType { kNumber, kBool, kString, kVector, kMatrix };
+enum class ParamType { kNumber, kBool, kString, kVector, kMatrix, kStringList };
 
 std::string_view param_type_name(ParamType t);
 
 using Vector = std::vector<double>;
 using Matrix = std::vector<std::vector<double>>;
-using ParamValue = std::variant<double, bool, std::string, Vector, Matrix>;
+using StringList = std::vector<std::string>;
+/// The alternatives are in ParamType's order.
+using ParamValue = std::variant<double, bool, std::string, Vector, Matrix, StringList>;
 
 ParamType param_type_of(const ParamValue& v);
-/// "0.5", "true", "\"text\"", "[1, 2]", "[[1, 2], [3]]".
+/// "0.5", "true", "\"text\"", "[1, 2]", "[[1, 2], [3]]", "[\"a\", \"b\"]".
 std::string to_string(const ParamValue& v);
 
 /// Parameter values by name. Getters return the fallback when the name is absent or holds
@@ -36,6 +38,7 @@ class Params {
   [[nodiscard]] std::string text(std::string_view name, std::string fallback = {}) const;
   [[nodiscard]] Vector vector(std::string_view name, Vector fallback = {}) const;
   [[nodiscard]] Matrix matrix(std::string_view name, Matrix fallback = {}) const;
+  [[nodiscard]] StringList strings(std::string_view name, StringList fallback = {}) const;
 
   [[nodiscard]] const std::map<std::string, ParamValue, std::less<>>& all() const { return values_; }
 

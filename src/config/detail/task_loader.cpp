@@ -132,8 +132,16 @@ std::string_view with_article(ParamType t) {
     case ParamType::kString: return "a string";
     case ParamType::kVector: return "a list of numbers";
     case ParamType::kMatrix: return "a list of lists of numbers";
+    case ParamType::kStringList: return "a list of strings";
   }
   return "?";
+}
+
+// An empty list is read as an empty vector, but it is as much an empty matrix or string list.
+void fit_empty_list(ParamValue& v, ParamType declared) {
+  if (!std::holds_alternative<Vector>(v) || !std::get<Vector>(v).empty()) return;
+  if (declared == ParamType::kMatrix) v = Matrix{};
+  if (declared == ParamType::kStringList) v = StringList{};
 }
 
 // Checks `params:` against the module's declared parameters and fills in the defaults.
@@ -156,9 +164,7 @@ Result<Params> read_params(const Source& source, const std::optional<Field>& fie
       }
       auto v = read_param_value(source, value);
       if (!v) return v.error();
-      // An empty list is as much an empty matrix as an empty vector.
-      if (decl->type == ParamType::kMatrix && std::holds_alternative<Vector>(*v) && std::get<Vector>(*v).empty())
-        *v = Matrix{};
+      fit_empty_list(*v, decl->type);
       if (param_type_of(*v) != decl->type)
         return source.fail(
             value, fmt::format("{} is {}, but {} of {} takes {}", to_string(*v), with_article(param_type_of(*v)), name,

@@ -190,6 +190,27 @@ Result<std::vector<double>> read_numbers(const Source& source, const Field& fiel
   return out;
 }
 
+namespace {
+
+// Every entry a scalar that is not a plain number: a number among text is more likely a mistake
+// than a name, and quoting it ("3") says it is text.
+Result<ParamValue> read_string_list(const Source& source, const Field& field) {
+  StringList list;
+  for (std::size_t i = 0; i < field.node.size(); ++i) {
+    const Field e = element(field, i, field.node[i]);
+    if (!e.node.IsScalar() || e.node.Scalar().empty())
+      return source.fail(e,
+                         fmt::format("{} is not text, but the list holds text (a list of strings)", describe(e.node)));
+    if (as_number(e.node))
+      return source.fail(
+          e, fmt::format("{} is a number, but the list holds text (quote it to make it text)", describe(e.node)));
+    list.push_back(e.node.Scalar());
+  }
+  return ParamValue{std::move(list)};
+}
+
+}  // namespace
+
 Result<ParamValue> read_param_value(const Source& source, const Field& field) {
   const YAML::Node& node = field.node;
   if (node.IsNull()) return source.fail(field, "needs a value");
@@ -200,8 +221,10 @@ Result<ParamValue> read_param_value(const Source& source, const Field& field) {
     if (auto b = as_bool(node)) return ParamValue{*b};
     return ParamValue{node.Scalar()};
   }
-  // A list: of numbers (a vector) or of lists of numbers (a matrix), decided by its first entry.
+  // A list: of numbers (a vector), of lists of numbers (a matrix) or of text (a list of strings),
+  // decided by its first entry.
   if (node.size() == 0) return ParamValue{Vector{}};
+  if (node[0].IsScalar() && !as_number(node[0])) return read_string_list(source, field);
   if (!node[0].IsSequence()) {
     Vector v;
     for (std::size_t i = 0; i < node.size(); ++i) {

@@ -86,7 +86,8 @@ Result<std::int64_t> read_duration(const Source& source, const Field& field);
 Result<std::int64_t> read_frequency_period(const Source& source, const Field& field);
 /// A number or a non-empty list of numbers (`constants:` values).
 Result<std::vector<double>> read_numbers(const Source& source, const Field& field);
-/// A parameter value: number, bool, text, list of numbers, or list of lists of numbers.
+/// A parameter value: number, bool, text, list of numbers, list of lists of numbers, or list of
+/// text.
 Result<ParamValue> read_param_value(const Source& source, const Field& field);
 
 }  // namespace chimera::config_detail

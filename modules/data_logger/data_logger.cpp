@@ -1,0 +1,292 @@
+// data_logger: the paper's data logger (section 3), a task that only gathers data and so has no
+// output ports. Each cycle copies the chosen variables into a preallocated ring; an ordinary
+// thread drains the ring into a CSV file, so the real-time path never formats, writes or waits.
+
+#include <pthread.h>
+#include <sched.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <filesystem>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <system_error>
+#include <thread>
+#include <vector>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "chimera/module/registry.hpp"
+#include "row_ring.hpp"
+
+namespace chimera::modules {
+namespace {
+
+constexpr std::size_t kMinRows = 1024;
+constexpr auto kDrainPeriod = std::chrono::milliseconds(20);
+constexpr auto kWaitForRoom = std::chrono::microseconds(20);
+constexpr std::size_t kWriteChunk = std::size_t{64} * 1024;  // bytes formatted before one fwrite
+
+// The variables to record, each once, in the order given.
+StringList variables_of(const Params& p) {
+  StringList out;
+  for (auto& v : p.strings("variables"))
+    if (std::find(out.begin(), out.end(), v) == out.end()) out.push_back(std::move(v));
+  return out;
+}
+
+// Where the CSV goes: `file`, or <task>.csv; a relative path below $CHIMERA_LOG_DIR if it is set.
+std::string log_path(const Params& p, std::string_view task) {
+  std::filesystem::path file = p.text("file");
+  if (file.empty()) file = std::string(task) + ".csv";
+  // NOLINTNEXTLINE(concurrency-mt-unsafe): read in init; nothing in chimera changes the environment
+  const char* dir = std::getenv("CHIMERA_LOG_DIR");
+  if (file.is_relative() && dir != nullptr && *dir != '\0') file = std::filesystem::path(dir) / file;
+  return file.string();
+}
+
+// The writer is an ordinary thread, whatever the task's thread is: it must not inherit SCHED_FIFO
+// or the task's CPU (threads inherit both from their creator).
+void become_ordinary_thread() {
+  sched_param normal{};
+  normal.sched_priority = 0;
+  (void)pthread_setschedparam(pthread_self(), SCHED_OTHER, &normal);
+  cpu_set_t all;
+  CPU_ZERO(&all);
+  if (sched_getaffinity(::getpid(), sizeof(all), &all) == 0)  // the process's (main thread's) CPUs
+    (void)pthread_setaffinity_np(pthread_self(), sizeof(all), &all);
+}
+
+class DataLogger final : public Module {
+ public:
+  static constexpr const char* kName = "data_logger";
+  static constexpr const char* kSummary = "records chosen state variables to a CSV file (no outputs)";
+  static constexpr const char* kDoc =
+      "The paper's data logger: a task that only gathers data, with one in-var port for each name in "
+      "variables (a port takes the size its variable has elsewhere in the file; rename: binds a port "
+      "to another variable). Each cycle it copies the release time t (s, on the subsystem's clock) "
+      "and every element of every variable (nan before the variable has data) into a preallocated "
+      "ring of capacity rows (0: one second's worth at the task's period, at least 1024). An ordinary "
+      "thread drains the ring every 20 ms into the CSV file (default <task>.csv; a relative path goes "
+      "below $CHIMERA_LOG_DIR when it is set): a header t,name[0],name[1],... (a one-element variable "
+      "is just name), then one row a cycle, each number in its shortest exact form. The cycle never "
+      "waits, formats or writes: when the ring is full on the real clock the row is dropped and "
+      "counted (reported when the task is killed); on the virtual clock the cycle waits for room, so "
+      "a virtual run's log is complete and the same run after run. `chimera plot FILE.csv -o "
+      "FILE.png` draws a log. See docs/modules/data_logger.md.";
+
+  static void declare(Declarations& d, const Params& p) {
+    for (const auto& v : variables_of(p)) d.in_var(v, Dim::follow(), "recorded, every element each cycle");
+    d.param("variables", StringList{}, "", "state variables to record (one in-var port each)");
+    d.param("file", std::string(), "", "CSV file; empty: <task>.csv; relative: below $CHIMERA_LOG_DIR if set");
+    d.param("capacity", 0.0, "rows", "ring size; 0: one second of rows at the task's period, at least 1024");
+    d.resource("a CSV file, written by an ordinary (not real-time) thread");
+  }
+
+  ~DataLogger() override { stop_writer(); }
+  DataLogger() = default;
+  DataLogger(const DataLogger&) = delete;
+  DataLogger& operator=(const DataLogger&) = delete;
+  DataLogger(DataLogger&&) = delete;
+  DataLogger& operator=(DataLogger&&) = delete;
+
+ protected:
+  Status init(InitContext& ctx) override {
+    const Params& p = ctx.params();
+    names_ = variables_of(p);
+    if (names_.empty()) return Status::fail("give variables: [names] to record");
+    std::size_t width = 1;  // t
+    for (const auto& name : names_) {
+      inputs_.push_back(ctx.in<double>(name));
+      width += inputs_.back().size();
+    }
+    if (ctx.failed()) return Status::ok();  // the framework reports the port that did not bind
+
+    const double capacity = p.number("capacity", 0.0);
+    if (!(capacity >= 0.0) || capacity > 1e8 || capacity != std::floor(capacity))
+      return Status::fail("capacity must be a whole number of rows from 0 to 1e8");
+    std::size_t rows = static_cast<std::size_t>(capacity);
+    if (rows == 0) {
+      const double period = ctx.period_s();
+      rows = period > 0.0 ? std::max(kMinRows, static_cast<std::size_t>(std::ceil(1.0 / period))) : kMinRows;
+    }
+    ring_ = std::make_unique<RowRing>(rows, width);
+
+    path_ = log_path(p, ctx.task_name());
+    task_ = std::string(ctx.task_name());
+    file_ = std::fopen(path_.c_str(), "w");
+    if (file_ == nullptr) {
+      spdlog::error("{}: cannot write the log {}: {}", task_, path_, std::generic_category().message(errno));
+      return Status::fail("cannot open the log file (param file) for writing");
+    }
+    out_.reserve(kWriteChunk + 4096);
+    write_header();
+    timing_ = &ctx.timing();
+    flags_ = &ctx.flags();
+    writer_ = std::thread([this] { write_loop(); });
+    return Status::ok();
+  }
+
+  // Real-time: copies into the ring, never waits on the real clock.
+  Status cycle() override {
+    double* row = ring_->claim();
+    if (row == nullptr) {
+      if (!flags_->clock_is_virtual()) {
+        dropped_.fetch_add(1, std::memory_order_relaxed);  // a counter; read once at kill
+        return Status::ok();
+      }
+      row = wait_for_room();
+      if (row == nullptr) {  // the writer has stopped: waiting would never end
+        dropped_.fetch_add(1, std::memory_order_relaxed);
+        return Status::ok();
+      }
+    }
+    row[0] = static_cast<double>(timing_->release_ns) / 1e9;  // correctly rounded: 0.03, not 0.030000000000000002
+    std::size_t at = 1;
+    for (const auto& in : inputs_) {
+      const bool data = in.has_data();
+      for (std::size_t i = 0; i < in.size(); ++i) row[at++] = data ? in[i] : std::numeric_limits<double>::quiet_NaN();
+    }
+    ring_->publish();
+    return Status::ok();
+  }
+
+  Status kill() override {
+    stop_writer();
+    const auto dropped = dropped_.load(std::memory_order_relaxed);
+    if (dropped > 0)
+      spdlog::warn("{}: {} rows not logged to {}: the ring of {} rows was full (raise capacity)", task_, dropped, path_,
+                   ring_->rows());
+    return Status::ok();
+  }
+
+ private:
+  // Virtual clock only: no deadline is real there, so the cycle waits for the writer, unless the
+  // writer has given up (nullptr).
+  double* wait_for_room() noexcept {
+    for (;;) {
+      wake_writer();
+      std::this_thread::sleep_for(kWaitForRoom);
+      if (double* row = ring_->claim()) return row;
+      // acquire: pairs with the writer's release when it gives up
+      if (writer_gone_.load(std::memory_order_acquire)) return nullptr;
+    }
+  }
+
+  void wake_writer() noexcept {
+    {
+      const std::lock_guard lock(mutex_);
+      wake_ = true;
+    }
+    wake_cv_.notify_one();
+  }
+
+  void write_header() {
+    out_.clear();
+    fmt::format_to(std::back_inserter(out_), "t");
+    for (std::size_t v = 0; v < names_.size(); ++v) {
+      const std::size_t n = inputs_[v].size();
+      for (std::size_t i = 0; i < n; ++i) {
+        if (n == 1)
+          fmt::format_to(std::back_inserter(out_), ",{}", names_[v]);
+        else
+          fmt::format_to(std::back_inserter(out_), ",{}[{}]", names_[v], i);
+      }
+    }
+    out_.push_back('\n');
+    flush_out();
+  }
+
+  void flush_out() {
+    if (!out_.empty()) (void)std::fwrite(out_.data(), 1, out_.size(), file_);
+    out_.clear();
+  }
+
+  // Formats every row the ring holds. In steady state it allocates nothing: the buffer keeps its
+  // capacity and the FILE its buffer.
+  void drain() {
+    ring_->drain([&](const double* row) {
+      for (std::size_t i = 0; i < ring_->width(); ++i) {
+        if (i != 0) out_.push_back(',');
+        fmt::format_to(std::back_inserter(out_), "{}", row[i]);
+      }
+      out_.push_back('\n');
+      if (out_.size() >= kWriteChunk) flush_out();
+    });
+    flush_out();
+    (void)std::fflush(file_);
+  }
+
+  void write_loop() {
+    become_ordinary_thread();
+    try {
+      std::unique_lock lock(mutex_);
+      while (!stop_) {
+        lock.unlock();
+        drain();
+        lock.lock();
+        wake_cv_.wait_for(lock, kDrainPeriod, [this] { return stop_ || wake_; });
+        wake_ = false;
+      }
+      lock.unlock();
+      drain();  // what the last cycles left
+    } catch (const std::exception& e) {
+      // Out of memory while formatting: the log ends here, the subsystem runs on.
+      failure_ = e.what();
+    }
+    writer_gone_.store(true, std::memory_order_release);  // release: failure_ is written before
+  }
+
+  void stop_writer() noexcept {
+    if (writer_.joinable()) {
+      {
+        const std::lock_guard lock(mutex_);
+        stop_ = true;
+      }
+      wake_cv_.notify_one();
+      writer_.join();
+      if (!failure_.empty()) spdlog::error("{}: the log {} is incomplete: {}", task_, path_, failure_);
+    }
+    if (file_ != nullptr) {
+      (void)std::fclose(file_);
+      file_ = nullptr;
+    }
+  }
+
+  StringList names_;
+  std::vector<In<double>> inputs_;
+  std::unique_ptr<RowRing> ring_;
+  const CycleTiming* timing_ = nullptr;
+  const SubsystemFlags* flags_ = nullptr;
+  std::atomic<std::uint64_t> dropped_{0};
+  std::atomic<bool> writer_gone_{false};
+
+  // The writer's side.
+  std::string task_;
+  std::string path_;
+  std::FILE* file_ = nullptr;
+  std::string out_;
+  std::string failure_;
+  std::thread writer_;
+  std::mutex mutex_;  // guards stop_ and wake_, never taken by a real-time cycle
+  std::condition_variable wake_cv_;
+  bool stop_ = false;
+  bool wake_ = false;
+};
+
+}  // namespace
+
+CHIMERA_REGISTER_MODULE(DataLogger);
+
+}  // namespace chimera::modules
