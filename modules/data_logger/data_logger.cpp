@@ -133,7 +133,6 @@ class DataLogger final : public Module {
     out_.reserve(kWriteChunk + 4096);
     write_header();
     timing_ = &ctx.timing();
-    flags_ = &ctx.flags();
     writer_ = std::thread([this] { write_loop(); });
     return Status::ok();
   }
@@ -142,7 +141,7 @@ class DataLogger final : public Module {
   Status cycle() override {
     double* row = ring_->claim();
     if (row == nullptr) {
-      if (!flags_->clock_is_virtual()) {
+      if (!timing_->virtual_clock) {
         dropped_.fetch_add(1, std::memory_order_relaxed);  // a counter; read once at kill
         return Status::ok();
       }
@@ -268,7 +267,6 @@ class DataLogger final : public Module {
   std::vector<In<double>> inputs_;
   std::unique_ptr<RowRing> ring_;
   const CycleTiming* timing_ = nullptr;
-  const SubsystemFlags* flags_ = nullptr;
   std::atomic<std::uint64_t> dropped_{0};
   std::atomic<bool> writer_gone_{false};
 

@@ -23,13 +23,11 @@ namespace chimera {
 namespace {
 class TableFlags final : public SubsystemFlags {
  public:
-  TableFlags(const GlobalTable* table, bool clock_is_virtual) : table_(table), virtual_(clock_is_virtual) {}
+  explicit TableFlags(const GlobalTable* table) : table_(table) {}
   [[nodiscard]] bool illegal_configuration() const noexcept override { return table_->illegal_configuration(); }
-  [[nodiscard]] bool clock_is_virtual() const noexcept override { return virtual_; }
 
  private:
   const GlobalTable* table_;
-  bool virtual_;
 };
 
 std::string join_lines(const std::vector<Violation>& violations) {
@@ -112,7 +110,7 @@ Result<std::unique_ptr<Subsystem>> Subsystem::create(const SubsystemSpec& spec, 
   auto table = GlobalTable::create(m.spec.name + m.options.shm_suffix, m.resolution.subsystem.variables);
   if (!table) return table.error();
   m.table = std::make_unique<GlobalTable>(std::move(*table));
-  m.flags = std::make_unique<TableFlags>(m.table.get(), m.options.clock == ClockKind::kVirtual);
+  m.flags = std::make_unique<TableFlags>(m.table.get());
   // Constants known up front (the file's and the out-consts modules declare) are in the table
   // before any init, so that an in-const reads its value whatever order tasks are spawned in.
   for (const auto& [name, values] : m.resolution.subsystem.constant_values) {

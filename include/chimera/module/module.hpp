@@ -67,10 +67,6 @@ class SubsystemFlags {
   virtual ~SubsystemFlags() = default;
   /// The paper's illegal-configuration flag (section 3.4). Real-time safe.
   [[nodiscard]] virtual bool illegal_configuration() const noexcept = 0;
-  /// Whether the subsystem runs on the virtual clock, where no deadline is real: a module may
-  /// then wait where on the real clock it would drop (the data logger with a full ring).
-  /// Real-time safe.
-  [[nodiscard]] virtual bool clock_is_virtual() const noexcept { return false; }
 };
 
 /// What wakes an aperiodic task (paper 3.3: events arrive through its resource port). A periodic
