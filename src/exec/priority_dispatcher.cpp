@@ -26,6 +26,7 @@ PriorityDispatcher::~PriorityDispatcher() {
 }
 
 void PriorityDispatcher::start(bool realtime) {
+  realtime_ = realtime;
   pthread_attr_t attr;
   pthread_attr_init(&attr);
   cpu_set_t set;
@@ -107,6 +108,7 @@ void PriorityDispatcher::rerank() {
         JobUrgency{w.job_release_ns.load(std::memory_order_relaxed), w.job_deadline_ns.load(std::memory_order_relaxed)};
   }
   rank(policy_, urgency_, jobs_, active_, order_, priorities_);
+  if (!realtime_) return;
   // Only active jobs are touched: an idle task put itself in the releasing band when its job
   // ended. With real-time priorities the dispatcher and the tasks of its CPU never run at the
   // same time (it preempts them), so the two writers of current_priority never overlap.

@@ -29,7 +29,8 @@ class PriorityDispatcher {
   PriorityDispatcher(const PriorityDispatcher&) = delete;
   PriorityDispatcher& operator=(const PriorityDispatcher&) = delete;
 
-  /// Starts the thread (SCHED_FIFO kPriority on `cpu` when `realtime`). Not real-time safe.
+  /// Starts the thread (SCHED_FIFO kPriority on `cpu` when `realtime`; without, it only keeps
+  /// the books: ordinary threads have no priorities to set). Not real-time safe.
   void start(bool realtime);
   /// Asks for the jobs to be ranked again now. Real-time safe (one futex wake).
   void poke() noexcept;
@@ -56,6 +57,7 @@ class PriorityDispatcher {
   std::vector<int> priorities_;
   pthread_t thread_{};
   bool started_ = false;
+  bool realtime_ = false;
   alignas(64) std::atomic<std::uint32_t> bell_{0};
   std::atomic<bool> stopping_{false};
 };

@@ -34,6 +34,8 @@ class RealExecutive {
   [[nodiscard]] std::int64_t now_ns() const;
   [[nodiscard]] std::int64_t epoch_ns() const { return epoch_ns_; }
   [[nodiscard]] const GlobalTable& table() const { return table_; }
+  /// Whether real-time priorities were asked for (they may still have been refused).
+  [[nodiscard]] bool realtime() const { return realtime_; }
   /// Carries out a signal on the task's own thread (started by spawn, ended by kill) and
   /// waits for it. Not real-time safe; never blocks a task's thread.
   Result<void> signal(std::size_t index, Signal sig);

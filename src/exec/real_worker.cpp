@@ -77,12 +77,15 @@ void Worker::main() {
 bool Worker::handle(std::uint32_t seq, std::int64_t& k) {
   const std::int64_t now = exec->now_ns();
   const TaskState before = task->state();
+  // A task turning on joins the grid at the next whole multiple of its period. Successors must
+  // see that release as scheduled as soon as they can see the task ON, or one of them could run
+  // its shared release without waiting for it: publish it before the state changes.
+  const std::int64_t join = task->periodic() ? (now + task->period_ns() - 1) / task->period_ns() : -1;
+  if (before != TaskState::kOn && request == Signal::kOn && task->periodic())
+    scheduled.store(join, std::memory_order_release);  // release: pairs with successors' acquire load
   reply = task->apply(request, now);
   if (before != TaskState::kOn && task->state() == TaskState::kOn) {
-    if (task->periodic()) {
-      const std::int64_t p = task->period_ns();
-      k = (now + p - 1) / p;  // join the grid at the next whole multiple of the period
-    }
+    if (task->periodic()) k = join;
     on_turned_on();
   }
   const bool alive = task->state() != TaskState::kNotCreated;

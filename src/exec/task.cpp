@@ -95,6 +95,7 @@ std::int64_t Task::absolute_deadline(std::int64_t release_ns) const noexcept {
 std::int64_t Task::begin_job(std::int64_t release_ns, std::int64_t start_ns) noexcept {
   if (state() != TaskState::kOn) return -1;
   timing_.release_ns = release_ns;
+  timing_.start_ns = start_ns;
   job_ = Job{true, false, release_ns, start_ns, exec_clock_now()};
   module_->virtual_ns_ = 0;
   local_->pull_in_vars();
@@ -176,7 +177,7 @@ Result<void> Task::spawn(std::int64_t now_ns) {
   if (!local) return make_error(Errc::kModuleFault, fmt::format("{}: {}", spec_.name, local.error().message));
   local_ = std::make_unique<LocalTable>(std::move(*local));
   module_ = resolved_.module->make();
-  timing_ = CycleTiming{now_ns, spec_.period_ns.value_or(0), 0, virtual_clock_, Fault::kNone};
+  timing_ = CycleTiming{now_ns, now_ns, spec_.period_ns.value_or(0), 0, virtual_clock_, Fault::kNone};
   trigger_ = Trigger{};
   job_ = Job{};
 

@@ -35,7 +35,8 @@ class VirtualExecutive {
   /// A new plan (MUF's critical set after a switch), from the next dispatch on.
   void set_plan(SchedulePlan plan) { plan_ = std::move(plan); }
 
-  /// How often descriptors of aperiodic tasks are polled when nothing else happens.
+  /// How often the descriptor of an idle aperiodic task is polled while it has nothing to read;
+  /// after a job it is polled again at once (the descriptor is level-triggered).
   static constexpr std::int64_t kPollPeriodNs = 1'000'000;
 
  private:
@@ -59,9 +60,10 @@ class VirtualExecutive {
     std::int64_t first_release_ns = 0;       // periodic: the first release since it turned on
     std::int64_t last_done_release_ns = -1;  // the release of the last job that ended
     std::int64_t job_start_ns = 0;
-    std::uint64_t events = 0;        // aperiodic: events not served yet
-    std::uint64_t seen_version = 0;  // aperiodic, update trigger: the variable's version served
-    int trigger_var = -1;            // aperiodic, update trigger: the variable's index
+    std::uint64_t events = 0;          // aperiodic: events not served yet
+    std::int64_t next_fd_poll_ns = 0;  // aperiodic, descriptor trigger: when to look at it again
+    std::uint64_t seen_version = 0;    // aperiodic, update trigger: the variable's version served
+    int trigger_var = -1;              // aperiodic, update trigger: the variable's index
     Server server;
   };
 
@@ -86,7 +88,6 @@ class VirtualExecutive {
   std::vector<int> running_;   // per CPU slot (index into plan_.cpu values via cpu_slot_): task or -1
   std::vector<int> cpu_slot_;  // per task: index into running_
   std::int64_t now_ns_ = 0;
-  std::int64_t next_poll_ns_ = 0;
 };
 
 }  // namespace chimera

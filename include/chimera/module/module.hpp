@@ -55,6 +55,7 @@ enum class Fault : std::uint8_t {
 /// virtual), so modules that use them stay deterministic on the virtual clock.
 struct CycleTiming {
   std::int64_t release_ns = 0;  // nominal release of the current cycle, since subsystem start
+  std::int64_t start_ns = 0;    // when the current cycle started, same clock
   std::int64_t period_ns = 0;   // 0 for an aperiodic task
   std::uint64_t cycle = 0;      // cycles completed before this one
   bool virtual_clock = false;   // the subsystem runs on the simulated clock
