@@ -20,6 +20,7 @@
 namespace chimera {
 
 struct Worker;
+struct Mail;
 class PriorityDispatcher;
 
 class RealExecutive {
@@ -39,6 +40,10 @@ class RealExecutive {
   /// Carries out a signal on the task's own thread (started by spawn, ended by kill) and
   /// waits for it. Not real-time safe; never blocks a task's thread.
   Result<void> signal(std::size_t index, Signal sig);
+  /// Turns on the tasks `indices` (OFF) as one: on() on each task's thread, then every one's
+  /// first release at its first grid point at or after one common instant, so that none runs a
+  /// release before all are on. Not real-time safe.
+  Result<void> turn_on_together(const std::vector<std::size_t>& indices);
   /// Someone other than a task wrote variable `v` (the operator's `set`): wakes the aperiodic
   /// tasks triggered by it. Not real-time safe.
   void variable_written(VarIndex v);
@@ -46,6 +51,10 @@ class RealExecutive {
   [[nodiscard]] int fixed_priority(std::size_t index) const;
 
  private:
+  Result<void> start_thread(Worker& w);
+  /// Posts `mail` to a task's thread and waits for its answer. Not real-time safe.
+  Result<void> post(Worker& w, Mail mail);
+
   std::vector<std::unique_ptr<PriorityDispatcher>> dispatchers_;  // outlive the workers that poke them
   std::vector<std::unique_ptr<Worker>> workers_;
   const GlobalTable& table_;

@@ -154,8 +154,15 @@ Result<void> Subsystem::start() {
   };
   for (const std::size_t i : members)
     if (auto r = m.signal(i, Signal::kSpawn); !r) return abandon(r.error());
-  for (const std::size_t i : members)
-    if (auto r = m.signal(i, Signal::kOn); !r) return abandon(r.error());
+  // On together: no task runs a release before the others are on (the virtual clock does not
+  // move while they turn on, so there one after the other is together).
+  if (m.real_exec) {
+    if (auto r = m.real_exec->turn_on_together(members); !r) return abandon(r.error());
+  } else {
+    for (const std::size_t i : members)
+      if (auto r = m.signal(i, Signal::kOn); !r) return abandon(r.error());
+  }
+  m.collect_events();
   return {};
 }
 
