@@ -37,7 +37,7 @@ constexpr std::array kVerbs{
     VerbSpec{Verb::kGet, "get", 1, 1, "get VAR", "the current value of a state variable"},
     VerbSpec{Verb::kSet, "set", 2, kMany, "set VAR V..", "write a variable that no ON task produces"},
     VerbSpec{Verb::kWait, "wait", 1, 1, "wait DURATION", "let the subsystem run (e.g. 500ms) before the next command"},
-    VerbSpec{Verb::kStats, "stats", 0, 0, "stats", "the timing table"},
+    VerbSpec{Verb::kStats, "stats", 0, 1, "stats [TASK]", "the timing table, or one task's profile (histograms)"},
     VerbSpec{Verb::kQuit, "quit", 0, 0, "quit", "stop the subsystem cleanly (every task: off, then kill)"},
     VerbSpec{Verb::kHelp, "help", 0, 0, "help", "this list"},
 };
