@@ -78,6 +78,11 @@ Reply Control::execute(const Command& command) {
       case Verb::kOff:
       case Verb::kKill:
       case Verb::kClear: return signal_tasks(signal_of(command.verb), command.args);
+      case Verb::kSwitch: {
+        auto record = subsystem_.switch_to(command.args.at(0));
+        if (!record) return refused(record.error().message);
+        return said(describe(*record) + "\n");
+      }
       case Verb::kGet: return get(command.args.at(0));
       case Verb::kSet: return set(command.args.at(0), command.values);
       case Verb::kWait: {

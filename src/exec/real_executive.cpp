@@ -86,6 +86,7 @@ RealExecutive::RealExecutive(const std::vector<Task*>& tasks, const ReleaseOrder
     auto w = std::make_unique<Worker>();
     w->exec = this;
     w->task = tasks[i];
+    w->index = i;
     w->cpu = plan.cpu[i];
     w->fixed_priority = priorities[i];
     if (!tasks[i]->periodic()) {
@@ -221,13 +222,42 @@ Result<void> RealExecutive::signal(std::size_t index, Signal sig) {
   return post(w, Mail{MailKind::kSignal, sig, 0});
 }
 
-Result<void> RealExecutive::turn_on_together(const std::vector<std::size_t>& indices) {
+Result<void> RealExecutive::turn_on_together(const std::vector<std::size_t>& indices, std::int64_t not_before_ns) {
   std::lock_guard<std::mutex> lock(control_mutex_);
+  return turn_on_locked(indices, not_before_ns);
+}
+
+Result<void> RealExecutive::commit_switch(const std::vector<std::size_t>& leaving,
+                                          const std::vector<std::size_t>& joining, std::int64_t commit_ns) {
+  std::lock_guard<std::mutex> lock(control_mutex_);
+  // Every leaving task answers once it is off: after its last release before the commit. Only
+  // then may a joining task turn on, since on() publishes outputs a leaving task wrote: one
+  // writer per variable at any time.
+  for (const std::size_t i : leaving)
+    if (auto r = post(*workers_[i], Mail{MailKind::kLeaveAt, Signal::kOff, epoch_ns_ + commit_ns}); !r) return r;
+  return turn_on_locked(joining, commit_ns);
+}
+
+void RealExecutive::set_plan(const SchedulePlan& plan) {
+  std::lock_guard<std::mutex> lock(control_mutex_);
+  for (auto& d : dispatchers_) {
+    std::vector<TaskUrgency> urgency;
+    for (const Worker* w : d->workers()) urgency.push_back(plan.urgency[w->index]);
+    d->set_urgency(urgency);
+  }
+}
+
+Result<void> RealExecutive::reinit(std::size_t index) {
+  std::lock_guard<std::mutex> lock(control_mutex_);
+  return post(*workers_[index], Mail{MailKind::kReinit, Signal::kOn, 0});
+}
+
+Result<void> RealExecutive::turn_on_locked(const std::vector<std::size_t>& indices, std::int64_t not_before_ns) {
   for (const std::size_t i : indices)
     if (auto r = post(*workers_[i], Mail{MailKind::kOnHeld, Signal::kOn, 0}); !r) return r;
   // Every task is on and waits; now one instant for all: each task's first release is its first
   // grid point at or after it, published before any is let go (the same-rate rule reads it).
-  const std::int64_t instant = now_ns();
+  const std::int64_t instant = std::max(now_ns(), not_before_ns);
   std::vector<std::pair<std::size_t, std::int64_t>> joins;
   for (const std::size_t i : indices) {
     Worker& w = *workers_[i];

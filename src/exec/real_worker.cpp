@@ -98,6 +98,12 @@ bool Worker::handle(std::uint32_t seq, std::int64_t& k) {
       if (!task->periodic() || task->state() != TaskState::kOn || exec->epoch_ns() + k * task->period_ns() >= leave_at)
         leave();
       return task->state() != TaskState::kNotCreated;
+    case MailKind::kReinit:
+      reply = task->reinit(now)
+                  ? Result<void>{}
+                  : make_error(Errc::kModuleFault, task->name() + ": reinit failed; the task is no longer ON");
+      reply_to(seq);
+      return task->state() != TaskState::kNotCreated;
     case MailKind::kSignal:
     case MailKind::kOnHeld: break;
   }

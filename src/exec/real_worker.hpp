@@ -25,6 +25,7 @@ enum class MailKind : std::uint8_t {
   kOnHeld,   // turn on, but release nothing until kJoin: tasks that start together
   kJoin,     // first release at index `at`, set by the control thread for every task of a group
   kLeaveAt,  // turn off before the first release at or after absolute time `at`; reply once off
+  kReinit,   // an in-const changed: reinit() between two cycles
 };
 
 struct Mail {
@@ -37,6 +38,7 @@ struct Worker {
   // Fixed at construction (before any thread starts).
   RealExecutive* exec = nullptr;
   Task* task = nullptr;
+  std::size_t index = 0;              // the task's position in the file
   std::vector<Worker*> predecessors;  // same-period producers that run before it at a shared release
   std::vector<Worker*> subscribers;   // aperiodic tasks that read one of its out-vars
   std::vector<int> out_vars;          // global indices of its out-vars

@@ -204,14 +204,22 @@ void VirtualExecutive::step() {
   dispatch();
 }
 
-void VirtualExecutive::run_until(std::int64_t end_ns) {
+bool VirtualExecutive::run_until(std::int64_t end_ns, const std::atomic<std::uint32_t>* watch) {
+  const std::uint32_t seen = watch != nullptr ? watch->load(std::memory_order_acquire) : 0;  // acquire: the request
   for (;;) {
     step();
+    if (watch != nullptr && watch->load(std::memory_order_acquire) != seen) return false;  // acquire: as above
     const std::int64_t t = next_event_after_dispatch();
     if (t >= end_ns) break;
     advance_to(t);
   }
   if (end_ns > now_ns_) advance_to(end_ns);
+  return true;
+}
+
+Result<void> VirtualExecutive::reinit(std::size_t task) {
+  if (tasks_[task]->reinit(now_ns_)) return {};
+  return make_error(Errc::kModuleFault, tasks_[task]->name() + ": reinit failed; the task is no longer ON");
 }
 
 void VirtualExecutive::end_open_job(std::size_t i) {

@@ -10,6 +10,7 @@
 // preempted meanwhile, and publishes its outputs when it ends. With no simulated time a job
 // starts and ends at its release, in policy order.
 
+#include <atomic>
 #include <cstdint>
 #include <vector>
 
@@ -30,8 +31,11 @@ class VirtualExecutive {
   /// (as on the real clock, where signals are handled between cycles).
   Result<void> signal(std::size_t task, Signal signal);
   /// Runs every event before `end_ns`, then sets the time to `end_ns` (jobs in progress keep
-  /// their remaining time).
-  void run_until(std::int64_t end_ns);
+  /// their remaining time). With `watch`, stops early at the first instant after which its value
+  /// has changed (a task asked for a switch), and returns false. Real-time safe.
+  bool run_until(std::int64_t end_ns, const std::atomic<std::uint32_t>* watch = nullptr);
+  /// reinit() of task `task` at the current simulated time.
+  Result<void> reinit(std::size_t task);
   /// A new plan (MUF's critical set after a switch), from the next dispatch on.
   void set_plan(SchedulePlan plan) { plan_ = std::move(plan); }
 
