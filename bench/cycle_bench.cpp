@@ -46,8 +46,8 @@ class PidFixture {
     if (!spec) die(spec.error().message);
     spec_ = std::make_unique<SubsystemSpec>(std::move(*spec));
     resolution_ = std::make_unique<Resolution>(resolve_subsystem(*spec_, Registry::global()));
-    auto table = GlobalTable::create(fmt::format("bench_cycle_{}_{}", ::getpid(), counter_++),
-                                     resolution_->subsystem.variables);
+    auto table =
+        GlobalTable::create(fmt::format("bench_cycle_{}_{}", ::getpid(), counter_++), resolution_->subsystem.variables);
     if (!table) die(table.error().message);
     table_ = std::make_unique<GlobalTable>(std::move(*table));
     const double ndof = 6;

@@ -123,6 +123,7 @@ int main(int argc, char** argv) {
   d["missed_deadlines"] = missed;
   d["latency_p99_ns_over_tasks"] = summary(p99s);
   d["cpu_percent_of_one_core"] = 100.0 * cpu_s / wall_s;
-  if (tasks == 1000) out.result("tasks_1000_at_100hz_cpu_percent", 100.0 * cpu_s / (wall_s * static_cast<double>(cpus)));
+  if (tasks == 1000)
+    out.result("tasks_1000_at_100hz_cpu_percent", 100.0 * cpu_s / (wall_s * static_cast<double>(cpus)));
   return out.write(args);
 }

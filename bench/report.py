@@ -123,7 +123,8 @@ def machine_lines(m):
         f"- Kernel: {m.get('kernel')}; clocksource {m.get('clocksource')}",
         f"- SCHED_FIFO: {fifo}; RT throttling {m.get('sched_rt_runtime_us')} µs per second",
         f"- Load average before / after: {', '.join(f'{x:.2f}' for x in m.get('load_average_before', []))} / "
-        f"{', '.join(f'{x:.2f}' for x in m.get('load_average_after', []))}; CPUs busy "
+        f"{', '.join(f'{x:.2f}' for x in m.get('load_average_after', []))} (after: inflated by the 1,000 "
+        f"threads of the 1,000-task benchmark); CPUs busy "
         f"{m.get('cpu_busy_percent_during_run')} % during the run (this run included), steal "
         f"{m.get('steal_percent_during_run')} %",
     ]
@@ -151,6 +152,11 @@ def write_report(doc, samples, results_dir, name="latest"):
         plots["release"] = "release_latency.png"
     if uncontended_plot(doc, results_dir / "uncontended.png"):
         plots["uncontended"] = "uncontended.png"
+    # Rewriting a saved run's report (no samples): keep the plots that run drew.
+    for key, png in (("contended", "contended_read.png"), ("ipc", "ipc_latency.png"),
+                     ("release", "release_latency.png")):
+        if key not in plots and not samples and (results_dir / png).exists():
+            plots[key] = png
 
     lines = [f"# Chimera benchmarks: {doc['mode']} run of {doc['date']}", ""]
     lines += [f"Commit `{doc.get('commit')}`, `make bench{'-quick' if doc['mode'] == 'quick' else ''}` "

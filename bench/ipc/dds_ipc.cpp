@@ -8,9 +8,9 @@
 #include <cstdlib>
 #include <string>
 
-#include "latest_value.h"
 #include "dds/dds.h"
 #include "ipc/ipc_latency.hpp"
+#include "latest_value.h"
 
 namespace chimera::bench {
 namespace {
@@ -50,7 +50,8 @@ class Participant {
 struct DdsPub {
   Participant p;
   dds_entity_t writer;
-  explicit DdsPub(int domain) : p(domain), writer(p.ok() ? dds_create_writer(p.participant(), p.topic(), p.qos(), nullptr) : -1) {}
+  explicit DdsPub(int domain)
+      : p(domain), writer(p.ok() ? dds_create_writer(p.participant(), p.topic(), p.qos(), nullptr) : -1) {}
   bool ready() {
     dds_publication_matched_status_t st{};
     return dds_get_publication_matched_status(writer, &st) == DDS_RETCODE_OK && st.current_count > 0;
@@ -61,7 +62,8 @@ struct DdsPub {
 struct DdsSub {
   Participant p;
   dds_entity_t reader;
-  explicit DdsSub(int domain) : p(domain), reader(p.ok() ? dds_create_reader(p.participant(), p.topic(), p.qos(), nullptr) : -1) {}
+  explicit DdsSub(int domain)
+      : p(domain), reader(p.ok() ? dds_create_reader(p.participant(), p.topic(), p.qos(), nullptr) : -1) {}
   bool take_latest(Message& m) {
     chimera_bench_LatestValue sample{};
     void* samples[1] = {&sample};

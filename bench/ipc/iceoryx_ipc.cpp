@@ -5,12 +5,11 @@
 //
 //   iceoryx_ipc [--quick] [--out FILE] [--samples-dir DIR] [--roudi PATH]
 
+#include <fcntl.h>
 #include <spawn.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
-
-#include <fcntl.h>
 
 #include <array>
 #include <csignal>

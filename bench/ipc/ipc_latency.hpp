@@ -36,20 +36,20 @@ namespace chimera::bench {
 
 /// The payload: a joint-space vector (six doubles, like Figure 4's theta_m) with its stamps.
 struct Message {
-  std::uint64_t seq = 0;       // 1, 2, ...: tells a new message from one seen before
-  std::int64_t stamp_ns = 0;   // just before the publish call
-  std::int64_t release_ns = 0; // the publisher's grid instant for this message
+  std::uint64_t seq = 0;        // 1, 2, ...: tells a new message from one seen before
+  std::int64_t stamp_ns = 0;    // just before the publish call
+  std::int64_t release_ns = 0;  // the publisher's grid instant for this message
   std::array<double, 6> value{};
 };
 
 struct IpcPlan {
   int messages = 10'000;
-  std::int64_t period_ns = 1'000'000;  // 1 kHz, a control rate
+  std::int64_t period_ns = 1'000'000;     // 1 kHz, a control rate
   std::int64_t poll_before_ns = 200'000;  // the subscriber polls from this long before a release
-  int warmup = 200;                    // first messages not recorded
+  int warmup = 200;                       // first messages not recorded
   int publisher_cpu = 0;
   int subscriber_cpu = 1;
-  int priority = 70;                   // SCHED_FIFO, below Chimera's task threads (80)
+  int priority = 70;                               // SCHED_FIFO, below Chimera's task threads (80)
   std::int64_t ready_timeout_ns = 10'000'000'000;  // discovery (DDS) may take a while
 };
 
@@ -83,7 +83,8 @@ inline void sleep_until(std::int64_t t) {
 namespace detail {
 
 template <class Pub>
-[[noreturn]] void publisher_main(const IpcPlan& plan, int go_fd, const std::function<std::unique_ptr<Pub>()>& make_pub) {
+[[noreturn]] void publisher_main(const IpcPlan& plan, int go_fd,
+                                 const std::function<std::unique_ptr<Pub>()>& make_pub) {
   char byte = 0;
   if (::read(go_fd, &byte, 1) != 1) ::_exit(3);  // the subscriber gave up
   auto pub = make_pub();

@@ -17,7 +17,6 @@ namespace {
 constexpr std::uint32_t kWords = sizeof(Message) / 8;
 static_assert(sizeof(Message) % 8 == 0);
 
-
 struct SvtSub {
   GlobalTable table;
   std::uint64_t seen = 0;
