@@ -1,6 +1,8 @@
 #include "priority_dispatcher.hpp"
 
 #include <algorithm>
+#include <chrono>
+#include <thread>
 
 #include "futex.hpp"
 
@@ -11,7 +13,7 @@ PriorityDispatcher::PriorityDispatcher(int cpu, SchedulerKind policy, std::vecto
     : cpu_(cpu),
       policy_(policy),
       workers_(std::move(workers)),
-      urgency_(std::move(urgency)),
+      urgency_{urgency, urgency},
       jobs_(workers_.size()),
       active_(workers_.size(), false),
       order_(workers_.size(), 0),
@@ -26,6 +28,7 @@ PriorityDispatcher::~PriorityDispatcher() {
 }
 
 void PriorityDispatcher::start(bool realtime) {
+  realtime_ = realtime;
   pthread_attr_t attr;
   pthread_attr_init(&attr);
   cpu_set_t set;
@@ -99,14 +102,32 @@ void PriorityDispatcher::rank(SchedulerKind policy, const std::vector<TaskUrgenc
         std::max(kLowestJobPriority, kTopJobPriority - static_cast<int>(r));
 }
 
+void PriorityDispatcher::set_urgency(const std::vector<TaskUrgency>& urgency) {
+  const std::uint32_t next = flips_.load(std::memory_order_relaxed) + 1;  // only this caller writes it
+  urgency_[next % 2] = urgency;                   // the set the dispatcher is not reading: it took the other
+  flips_.store(next, std::memory_order_release);  // release: publishes the new set
+  poke();
+  // The dispatcher takes it at its next ranking; without real-time priorities it may take a
+  // while, so wait politely (this is the control thread, never a task's).
+  while (started_ && taken_.load(std::memory_order_acquire) != next) {  // acquire: it no longer reads the old set
+    poke();
+    std::this_thread::sleep_for(std::chrono::microseconds(50));
+  }
+  if (!started_) taken_.store(next, std::memory_order_relaxed);
+}
+
 void PriorityDispatcher::rerank() {
+  const std::uint32_t flips = flips_.load(std::memory_order_acquire);  // acquire: the set it names
+  const std::vector<TaskUrgency>& urgency = urgency_[flips % 2];
   for (std::size_t i = 0; i < workers_.size(); ++i) {
     const Worker& w = *workers_[i];
     active_[i] = w.job_active.load(std::memory_order_acquire);  // acquire: its release and deadline
     jobs_[i] =
         JobUrgency{w.job_release_ns.load(std::memory_order_relaxed), w.job_deadline_ns.load(std::memory_order_relaxed)};
   }
-  rank(policy_, urgency_, jobs_, active_, order_, priorities_);
+  rank(policy_, urgency, jobs_, active_, order_, priorities_);
+  taken_.store(flips, std::memory_order_release);  // release: done with the other set
+  if (!realtime_) return;
   // Only active jobs are touched: an idle task put itself in the releasing band when its job
   // ended. With real-time priorities the dispatcher and the tasks of its CPU never run at the
   // same time (it preempts them), so the two writers of current_priority never overlap.

@@ -8,6 +8,7 @@
 // the order of the other jobs does not change when one ends. docs/scheduling.md says why this
 // design and not SCHED_DEADLINE.
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <vector>
@@ -29,11 +30,17 @@ class PriorityDispatcher {
   PriorityDispatcher(const PriorityDispatcher&) = delete;
   PriorityDispatcher& operator=(const PriorityDispatcher&) = delete;
 
-  /// Starts the thread (SCHED_FIFO kPriority on `cpu` when `realtime`). Not real-time safe.
+  /// Starts the thread (SCHED_FIFO kPriority on `cpu` when `realtime`; without, it only keeps
+  /// the books: ordinary threads have no priorities to set). Not real-time safe.
   void start(bool realtime);
   /// Asks for the jobs to be ranked again now. Real-time safe (one futex wake).
   void poke() noexcept;
+  /// New urgency data for its tasks (MUF's critical set after a switch), in the order of the
+  /// workers given at construction; returns once the dispatcher ranks by it. Not real-time safe;
+  /// one caller at a time.
+  void set_urgency(const std::vector<TaskUrgency>& urgency);
   [[nodiscard]] int cpu() const { return cpu_; }
+  [[nodiscard]] const std::vector<Worker*>& workers() const { return workers_; }
 
   /// The priorities that `policy` gives jobs `jobs` of tasks `urgency` (parallel arrays; only
   /// entries with active[i] count): kTopJobPriority for the most urgent, one less each after,
@@ -48,7 +55,11 @@ class PriorityDispatcher {
   int cpu_;
   SchedulerKind policy_;
   std::vector<Worker*> workers_;
-  std::vector<TaskUrgency> urgency_;
+  // Two sets of urgency data: the dispatcher ranks by urgency_[active_set_]; set_urgency() fills
+  // the other, flips the index and waits until the dispatcher has taken it (taken_ == flips_).
+  std::array<std::vector<TaskUrgency>, 2> urgency_;
+  alignas(64) std::atomic<std::uint32_t> flips_{0};
+  std::atomic<std::uint32_t> taken_{0};
   // Scratch, sized once: ranking allocates nothing.
   std::vector<JobUrgency> jobs_;
   std::vector<bool> active_;
@@ -56,6 +67,7 @@ class PriorityDispatcher {
   std::vector<int> priorities_;
   pthread_t thread_{};
   bool started_ = false;
+  bool realtime_ = false;
   alignas(64) std::atomic<std::uint32_t> bell_{0};
   std::atomic<bool> stopping_{false};
 };

@@ -86,6 +86,7 @@ RealExecutive::RealExecutive(const std::vector<Task*>& tasks, const ReleaseOrder
     auto w = std::make_unique<Worker>();
     w->exec = this;
     w->task = tasks[i];
+    w->index = i;
     w->cpu = plan.cpu[i];
     w->fixed_priority = priorities[i];
     if (!tasks[i]->periodic()) {
@@ -150,49 +151,48 @@ void* worker_entry(void* arg) {
 }
 }  // namespace
 
-Result<void> RealExecutive::signal(std::size_t index, Signal sig) {
-  std::lock_guard<std::mutex> lock(control_mutex_);
-  Worker& w = *workers_[index];
-  if (!w.running) {
-    if (sig != Signal::kSpawn) return w.task->apply(sig, now_ns());  // refused by the state table
-    pthread_attr_t attr;
-    pthread_attr_init(&attr);
-    pthread_attr_setstacksize(&attr, kStackBytes);
-    cpu_set_t cpus;
-    CPU_ZERO(&cpus);
-    CPU_SET(static_cast<unsigned>(w.cpu), &cpus);
-    // Partitioned scheduling needs real-time priorities; ordinary threads do better where the
-    // kernel balances them (pinned, they starve behind other load), unless the file pins them.
-    if (realtime_ || w.task->spec().cpu) pthread_attr_setaffinity_np(&attr, sizeof(cpu_set_t), &cpus);
-    int rc = EPERM;
-    if (realtime_) {
-      sched_param sp{};
-      sp.sched_priority = w.fixed_priority;
-      pthread_attr_setinheritsched(&attr, PTHREAD_EXPLICIT_SCHED);
-      pthread_attr_setschedpolicy(&attr, SCHED_FIFO);
-      pthread_attr_setschedparam(&attr, &sp);
-      w.current_priority.store(w.fixed_priority, std::memory_order_relaxed);  // before the thread exists
-      rc = pthread_create(&w.thread, &attr, worker_entry, &w);
-      if (rc == EPERM)
-        warn_once(g_warned_fifo,
-                  "SCHED_FIFO is not permitted here: tasks run as ordinary threads, so priorities (and the edf "
-                  "and muf policies) are not enforced (run as root or grant CAP_SYS_NICE / an rtprio limit)");
-    }
-    if (rc == EPERM) {
-      pthread_attr_setinheritsched(&attr, PTHREAD_INHERIT_SCHED);
-      if (!w.task->spec().cpu && sched_getaffinity(0, sizeof(cpu_set_t), &cpus) == 0)
-        pthread_attr_setaffinity_np(&attr, sizeof(cpu_set_t), &cpus);  // ordinary threads: unpinned
-      rc = pthread_create(&w.thread, &attr, worker_entry, &w);
-    }
-    pthread_attr_destroy(&attr);
-    if (rc != 0)
-      return make_error(Errc::kSystem, fmt::format("{}: cannot start its thread: {}", w.task->name(),
-                                                   std::generic_category().message(rc)));
-    w.running = true;
+Result<void> RealExecutive::start_thread(Worker& w) {
+  pthread_attr_t attr;
+  pthread_attr_init(&attr);
+  pthread_attr_setstacksize(&attr, kStackBytes);
+  cpu_set_t cpus;
+  CPU_ZERO(&cpus);
+  CPU_SET(static_cast<unsigned>(w.cpu), &cpus);
+  // Partitioned scheduling needs real-time priorities; ordinary threads do better where the
+  // kernel balances them (pinned, they starve behind other load), unless the file pins them.
+  if (realtime_ || w.task->spec().cpu) pthread_attr_setaffinity_np(&attr, sizeof(cpu_set_t), &cpus);
+  int rc = EPERM;
+  if (realtime_) {
+    sched_param sp{};
+    sp.sched_priority = w.fixed_priority;
+    pthread_attr_setinheritsched(&attr, PTHREAD_EXPLICIT_SCHED);
+    pthread_attr_setschedpolicy(&attr, SCHED_FIFO);
+    pthread_attr_setschedparam(&attr, &sp);
+    w.current_priority.store(w.fixed_priority, std::memory_order_relaxed);  // before the thread exists
+    rc = pthread_create(&w.thread, &attr, worker_entry, &w);
+    if (rc == EPERM)
+      warn_once(g_warned_fifo,
+                "SCHED_FIFO is not permitted here: tasks run as ordinary threads, so priorities (and the edf "
+                "and muf policies) are not enforced (run as root or grant CAP_SYS_NICE / an rtprio limit)");
   }
-  w.request = sig;
+  if (rc == EPERM) {
+    pthread_attr_setinheritsched(&attr, PTHREAD_INHERIT_SCHED);
+    if (!w.task->spec().cpu && sched_getaffinity(0, sizeof(cpu_set_t), &cpus) == 0)
+      pthread_attr_setaffinity_np(&attr, sizeof(cpu_set_t), &cpus);  // ordinary threads: unpinned
+    rc = pthread_create(&w.thread, &attr, worker_entry, &w);
+  }
+  pthread_attr_destroy(&attr);
+  if (rc != 0)
+    return make_error(Errc::kSystem, fmt::format("{}: cannot start its thread: {}", w.task->name(),
+                                                 std::generic_category().message(rc)));
+  w.running = true;
+  return {};
+}
+
+Result<void> RealExecutive::post(Worker& w, Mail mail) {
+  w.mail = mail;
   const std::uint32_t seq = w.request_seq.load(std::memory_order_relaxed) + 1;  // only this thread writes it
-  w.request_seq.store(seq, std::memory_order_release);                          // release: publishes `request`
+  w.request_seq.store(seq, std::memory_order_release);                          // release: publishes `mail`
   detail::futex_wake_all(w.request_seq);
   ring_bell(w);  // an aperiodic task may be asleep on its event source instead
   const std::int64_t give_up = monotonic_ns() + kReplyTimeoutNs;
@@ -200,8 +200,8 @@ Result<void> RealExecutive::signal(std::size_t index, Signal sig) {
     const std::uint32_t done = w.done_seq.load(std::memory_order_acquire);  // acquire: see `reply`
     if (done == seq) break;
     if (!detail::futex_wait(w.done_seq, done, give_up) && monotonic_ns() >= give_up)
-      return make_error(Errc::kModuleFault, fmt::format("{}: no answer to {} within 10 s (a method is stuck?)",
-                                                        w.task->name(), signal_name(sig)));
+      return make_error(Errc::kModuleFault,
+                        fmt::format("{}: no answer within 10 s (a method is stuck?)", w.task->name()));
   }
   Result<void> r = std::move(w.reply);
   w.reply = Result<void>{};
@@ -210,6 +210,66 @@ Result<void> RealExecutive::signal(std::size_t index, Signal sig) {
     w.running = false;
   }
   return r;
+}
+
+Result<void> RealExecutive::signal(std::size_t index, Signal sig) {
+  std::lock_guard<std::mutex> lock(control_mutex_);
+  Worker& w = *workers_[index];
+  if (!w.running) {
+    if (sig != Signal::kSpawn) return w.task->apply(sig, now_ns());  // refused by the state table
+    if (auto started = start_thread(w); !started) return started;
+  }
+  return post(w, Mail{MailKind::kSignal, sig, 0});
+}
+
+Result<void> RealExecutive::turn_on_together(const std::vector<std::size_t>& indices, std::int64_t not_before_ns) {
+  std::lock_guard<std::mutex> lock(control_mutex_);
+  return turn_on_locked(indices, not_before_ns);
+}
+
+Result<void> RealExecutive::commit_switch(const std::vector<std::size_t>& leaving,
+                                          const std::vector<std::size_t>& joining, std::int64_t commit_ns) {
+  std::lock_guard<std::mutex> lock(control_mutex_);
+  // Every leaving task answers once it is off: after its last release before the commit. Only
+  // then may a joining task turn on, since on() publishes outputs a leaving task wrote: one
+  // writer per variable at any time.
+  for (const std::size_t i : leaving)
+    if (auto r = post(*workers_[i], Mail{MailKind::kLeaveAt, Signal::kOff, epoch_ns_ + commit_ns}); !r) return r;
+  return turn_on_locked(joining, commit_ns);
+}
+
+void RealExecutive::set_plan(const SchedulePlan& plan) {
+  std::lock_guard<std::mutex> lock(control_mutex_);
+  for (auto& d : dispatchers_) {
+    std::vector<TaskUrgency> urgency;
+    for (const Worker* w : d->workers()) urgency.push_back(plan.urgency[w->index]);
+    d->set_urgency(urgency);
+  }
+}
+
+Result<void> RealExecutive::reinit(std::size_t index) {
+  std::lock_guard<std::mutex> lock(control_mutex_);
+  return post(*workers_[index], Mail{MailKind::kReinit, Signal::kOn, 0});
+}
+
+Result<void> RealExecutive::turn_on_locked(const std::vector<std::size_t>& indices, std::int64_t not_before_ns) {
+  for (const std::size_t i : indices)
+    if (auto r = post(*workers_[i], Mail{MailKind::kOnHeld, Signal::kOn, 0}); !r) return r;
+  // Every task is on and waits; now one instant for all: each task's first release is its first
+  // grid point at or after it, published before any is let go (the same-rate rule reads it).
+  const std::int64_t instant = std::max(now_ns(), not_before_ns);
+  std::vector<std::pair<std::size_t, std::int64_t>> joins;
+  for (const std::size_t i : indices) {
+    Worker& w = *workers_[i];
+    if (!w.task->periodic() || w.task->state() != TaskState::kOn) continue;
+    const std::int64_t p = w.task->period_ns();
+    const std::int64_t k = (instant + p - 1) / p;
+    w.scheduled.store(k, std::memory_order_release);  // release: pairs with successors' acquire load
+    joins.emplace_back(i, k);
+  }
+  for (const auto& [i, k] : joins)
+    if (auto r = post(*workers_[i], Mail{MailKind::kJoin, Signal::kOn, k}); !r) return r;
+  return {};
 }
 
 void RealExecutive::variable_written(VarIndex v) {

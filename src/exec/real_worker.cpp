@@ -49,7 +49,7 @@ void Worker::main() {
   std::uint32_t seen = 0;
   std::int64_t k = 0;
   for (;;) {
-    const std::uint32_t req = request_seq.load(std::memory_order_acquire);  // acquire: see `request`
+    const std::uint32_t req = request_seq.load(std::memory_order_acquire);  // acquire: see `mail`
     if (req != seen) {
       seen = req;
       if (!handle(req, k)) return;
@@ -74,21 +74,67 @@ void Worker::main() {
   }
 }
 
+void Worker::reply_to(std::uint32_t seq) {
+  done_seq.store(seq, std::memory_order_release);  // release: publishes `reply`
+  detail::futex_wake_all(done_seq);
+}
+
 bool Worker::handle(std::uint32_t seq, std::int64_t& k) {
   const std::int64_t now = exec->now_ns();
   const TaskState before = task->state();
+  switch (mail.kind) {
+    case MailKind::kJoin:
+      // The control thread has already published `scheduled` for every task of the group.
+      k = mail.at;
+      held = false;
+      reply = Result<void>{};
+      reply_to(seq);
+      return true;
+    case MailKind::kLeaveAt:
+      leave_at = mail.at;
+      leave_seq = seq;
+      // Not released and nothing to finish: an aperiodic task, or one already past its last
+      // release before the switch, leaves at once; otherwise after its current job (the loop).
+      if (!task->periodic() || task->state() != TaskState::kOn || exec->epoch_ns() + k * task->period_ns() >= leave_at)
+        leave();
+      return task->state() != TaskState::kNotCreated;
+    case MailKind::kReinit:
+      reply = task->reinit(now)
+                  ? Result<void>{}
+                  : make_error(Errc::kModuleFault, task->name() + ": reinit failed; the task is no longer ON");
+      reply_to(seq);
+      return task->state() != TaskState::kNotCreated;
+    case MailKind::kSignal:
+    case MailKind::kOnHeld: break;
+  }
+  const Signal request = mail.kind == MailKind::kOnHeld ? Signal::kOn : mail.signal;
+  // A task turning on joins the grid at the next whole multiple of its period. Successors must
+  // see that release as scheduled as soon as they can see the task ON, or one of them could run
+  // its shared release without waiting for it: publish it before the state changes. (A held
+  // task's release is published by the control thread before kJoin.)
+  const std::int64_t join = task->periodic() ? (now + task->period_ns() - 1) / task->period_ns() : -1;
+  const bool turning_on = before != TaskState::kOn && request == Signal::kOn;
+  if (turning_on && task->periodic() && mail.kind == MailKind::kSignal)
+    scheduled.store(join, std::memory_order_release);  // release: pairs with successors' acquire load
   reply = task->apply(request, now);
   if (before != TaskState::kOn && task->state() == TaskState::kOn) {
-    if (task->periodic()) {
-      const std::int64_t p = task->period_ns();
-      k = (now + p - 1) / p;  // join the grid at the next whole multiple of the period
-    }
+    if (task->periodic()) k = join;
+    held = mail.kind == MailKind::kOnHeld && task->periodic();
+    leave_at = -1;
     on_turned_on();
   }
   const bool alive = task->state() != TaskState::kNotCreated;
-  done_seq.store(seq, std::memory_order_release);  // release: publishes `reply`
-  detail::futex_wake_all(done_seq);
+  reply_to(seq);
   return alive;
+}
+
+void Worker::leave() {
+  const std::uint32_t seq = leave_seq;
+  leave_at = -1;
+  leave_seq = 0;
+  reply = task->state() == TaskState::kOn ? task->apply(Signal::kOff, exec->now_ns()) : Result<void>{};
+  held = false;
+  reply_to(seq);
 }
 
 void Worker::on_turned_on() noexcept {
@@ -131,9 +177,17 @@ std::int64_t Worker::run_job(std::int64_t release_abs) {
 }
 
 void Worker::run_periodic(std::uint32_t req, std::int64_t& k) {
+  if (held) {  // waiting for kJoin; `scheduled` is the control thread's until then
+    detail::futex_wait(request_seq, req, -1);
+    return;
+  }
   const std::int64_t period = task->period_ns();
   const std::int64_t epoch = exec->epoch_ns();
   std::int64_t release_abs = epoch + k * period;
+  if (leave_seq != 0 && release_abs >= leave_at) {
+    leave();  // a switch: this task's last release came before the commit
+    return;
+  }
   scheduled.store(k, std::memory_order_release);  // release: pairs with successors' acquire load
   const std::int64_t now = monotonic_ns();
   if (now < release_abs) {
@@ -194,7 +248,7 @@ void Worker::run_aperiodic(std::uint32_t req) {
       (void)!::read(bell_fd, &drained, sizeof(drained));
     }
   }
-  if (request_seq.load(std::memory_order_acquire) != req) return;  // a signal first; acquire: as in main
+  if (request_seq.load(std::memory_order_acquire) != req) return;  // the mail first; acquire: as in main
   if (exhausted || task->state() != TaskState::kOn) return;
   const bool fd_event = fd >= 0 && (fds[1].revents & (POLLIN | POLLERR | POLLHUP)) != 0;
   const bool update_event = update_pending.exchange(false, std::memory_order_acq_rel);  // acq_rel: see run_job

@@ -19,10 +19,26 @@ namespace chimera {
 class RealExecutive;
 class PriorityDispatcher;
 
+/// What the control thread asks of a task's thread.
+enum class MailKind : std::uint8_t {
+  kSignal,   // carry out `signal` (the paper's signals)
+  kOnHeld,   // turn on, but release nothing until kJoin: tasks that start together
+  kJoin,     // first release at index `at`, set by the control thread for every task of a group
+  kLeaveAt,  // turn off before the first release at or after absolute time `at`; reply once off
+  kReinit,   // an in-const changed: reinit() between two cycles
+};
+
+struct Mail {
+  MailKind kind = MailKind::kSignal;
+  Signal signal = Signal::kSpawn;
+  std::int64_t at = 0;
+};
+
 struct Worker {
   // Fixed at construction (before any thread starts).
   RealExecutive* exec = nullptr;
   Task* task = nullptr;
+  std::size_t index = 0;              // the task's position in the file
   std::vector<Worker*> predecessors;  // same-period producers that run before it at a shared release
   std::vector<Worker*> subscribers;   // aperiodic tasks that read one of its out-vars
   std::vector<int> out_vars;          // global indices of its out-vars
@@ -35,7 +51,7 @@ struct Worker {
 
   // Mailbox: written by the control thread, read by the task's thread.
   alignas(64) std::atomic<std::uint32_t> request_seq{0};
-  Signal request = Signal::kSpawn;
+  Mail mail;
   // Reply: written by the task's thread, read by the control thread.
   alignas(64) std::atomic<std::uint32_t> done_seq{0};
   Result<void> reply;
@@ -56,6 +72,11 @@ struct Worker {
   alignas(64) std::atomic<int> trigger_var{-1};
   std::atomic<bool> update_pending{false};
 
+  // Group starts and switches: touched only by the task's own thread.
+  bool held = false;            // ON, but waiting for kJoin before its first release
+  std::int64_t leave_at = -1;   // absolute time: turn off before the first release at or after it
+  std::uint32_t leave_seq = 0;  // the kLeaveAt request to answer once off (0: none)
+
   // Sporadic server: touched only by the task's own thread.
   static constexpr std::size_t kMaxRefills = 64;
   std::int64_t budget_ns = 0;
@@ -73,6 +94,9 @@ struct Worker {
 
  private:
   bool handle(std::uint32_t seq, std::int64_t& k);
+  void reply_to(std::uint32_t seq);
+  /// Turns off now for a pending kLeaveAt, and answers it.
+  void leave();
   void run_periodic(std::uint32_t seq, std::int64_t& k);
   void run_aperiodic(std::uint32_t seq);
   void wait_for_predecessors(std::int64_t k, std::int64_t release_abs) const;

@@ -30,11 +30,6 @@ Task::~Task() {
   if (state() != TaskState::kNotCreated) (void)apply(Signal::kKill, timing_.release_ns);
 }
 
-void Task::set_state(TaskState s) noexcept {
-  state_.store(s, std::memory_order_release);  // release: what the method did is visible to whoever sees the state
-  if (s == TaskState::kError) ever_in_error_.store(true, std::memory_order_relaxed);  // a latch, read on its own
-}
-
 Status Task::call_raw(Hook hook) noexcept {
   try {
     switch (hook) {
@@ -95,6 +90,7 @@ std::int64_t Task::absolute_deadline(std::int64_t release_ns) const noexcept {
 std::int64_t Task::begin_job(std::int64_t release_ns, std::int64_t start_ns) noexcept {
   if (state() != TaskState::kOn) return -1;
   timing_.release_ns = release_ns;
+  timing_.start_ns = start_ns;
   job_ = Job{true, false, release_ns, start_ns, exec_clock_now()};
   module_->virtual_ns_ = 0;
   local_->pull_in_vars();
@@ -128,6 +124,28 @@ std::int64_t Task::end_job(std::int64_t end_ns, std::int64_t used_ns) noexcept {
   return used_ns;
 }
 
+bool Task::reads_const(std::string_view name) const {
+  for (const auto& b : resolved_.bindings)
+    if (b.kind == PortKind::kInConst && b.variable == name) return true;
+  return false;
+}
+
+std::vector<std::string> Task::const_outputs() const {
+  std::vector<std::string> out;
+  for (const auto& b : resolved_.bindings)
+    if (b.kind == PortKind::kOutConst) out.push_back(b.variable);
+  return out;
+}
+
+bool Task::reinit(std::int64_t now_ns) noexcept {
+  if (state() != TaskState::kOn) return false;
+  local_->pull_in_consts();
+  reinits_.fetch_add(1, std::memory_order_relaxed);  // a counter read on its own
+  const Status s = call(Hook::kReinit);
+  if (!s.is_ok() && !recover(Hook::kReinit, s, now_ns)) return false;
+  return state() == TaskState::kOn;
+}
+
 void Task::skip_releases(std::uint64_t n, std::int64_t now_ns) noexcept {
   if (n == 0) return;
   stats_.record_skipped(n);
@@ -156,6 +174,16 @@ void Task::timing_fault(Fault fault, std::int64_t now_ns) noexcept {
   events_.push(now_ns, "ERROR: operator intervention required (clear): ", what);
 }
 
+void Task::set_state(TaskState s) noexcept {
+  state_.store(s, std::memory_order_release);  // release: what the method did is visible to whoever sees the state
+  if (s == TaskState::kError) {
+    ever_in_error_.store(true, std::memory_order_relaxed);  // a latch, read on its own
+    // The paper's flag also marks an error in the subsystem, so that critical modules keep the
+    // system safe; the subsystem interface lowers it once no task is in ERROR.
+    table_.set_illegal_configuration(true);
+  }
+}
+
 Result<void> Task::apply(Signal signal, std::int64_t now_ns) {
   const TaskState from = state();
   if (!transition(from, signal))
@@ -176,11 +204,11 @@ Result<void> Task::spawn(std::int64_t now_ns) {
   if (!local) return make_error(Errc::kModuleFault, fmt::format("{}: {}", spec_.name, local.error().message));
   local_ = std::make_unique<LocalTable>(std::move(*local));
   module_ = resolved_.module->make();
-  timing_ = CycleTiming{now_ns, spec_.period_ns.value_or(0), 0, virtual_clock_, Fault::kNone};
+  timing_ = CycleTiming{now_ns, now_ns, spec_.period_ns.value_or(0), 0, virtual_clock_, Fault::kNone};
   trigger_ = Trigger{};
   job_ = Job{};
 
-  InitContext ctx(spec_.name, spec_.params, *local_, timing_, flags_, trigger_);
+  InitContext ctx(spec_.name, spec_.params, *local_, timing_, flags_, trigger_, services_);
   local_->pull_in_consts();
   local_->pull_in_vars();
   Status s = Status::ok();
@@ -216,6 +244,9 @@ Result<void> Task::turn_on(std::int64_t now_ns) {
   timing_.release_ns = now_ns;
   const Status s = call(Hook::kOn);
   if (s.is_ok()) {
+    // Its out-consts are the subsystem's again: another producer of one of them may have
+    // published a different value while this task was off (a switch back).
+    local_->push_out_consts();
     set_state(TaskState::kOn);
     return {};
   }

@@ -75,8 +75,6 @@ void VirtualExecutive::release_periodic(std::size_t i) {
 }
 
 void VirtualExecutive::poll_triggers() {
-  const bool poll_fds = now_ns_ >= next_poll_ns_;
-  if (poll_fds) next_poll_ns_ = now_ns_ + kPollPeriodNs;
   for (std::size_t i = 0; i < tasks_.size(); ++i) {
     Task& t = *tasks_[i];
     Slot& s = slots_[i];
@@ -88,9 +86,12 @@ void VirtualExecutive::poll_triggers() {
         ++s.events;  // several writes at one instant are one event: the latest value is what counts
       }
     }
-    if (poll_fds && t.trigger().fd >= 0 && s.events == 0 && !s.job.active) {
+    if (t.trigger().fd >= 0 && s.events == 0 && !s.job.active && now_ns_ >= s.next_fd_poll_ns) {
       pollfd p{t.trigger().fd, POLLIN, 0};
-      if (::poll(&p, 1, 0) > 0 && (p.revents & (POLLIN | POLLERR | POLLHUP)) != 0) s.events = 1;
+      if (::poll(&p, 1, 0) > 0 && (p.revents & (POLLIN | POLLERR | POLLHUP)) != 0)
+        s.events = 1;
+      else
+        s.next_fd_poll_ns = now_ns_ + kPollPeriodNs;
     }
     const bool background = plan_.urgency[i].background;
     if (s.events > 0 && !s.job.active && (background || s.server.budget_ns > 0)) {
@@ -125,6 +126,7 @@ void VirtualExecutive::finish(std::size_t i) {
     s.server.budget_ns -= s.job.exec_ns;
   }
   s.job = Job{};
+  s.next_fd_poll_ns = now_ns_;  // level-triggered: look again right away
   const int c = cpu_slot_[i];
   if (running_[static_cast<std::size_t>(c)] == static_cast<int>(i)) running_[static_cast<std::size_t>(c)] = -1;
   if (t.periodic() && t.state() != TaskState::kOn) s.next_release_ns = -1;
@@ -171,18 +173,17 @@ void VirtualExecutive::dispatch() {
 
 std::int64_t VirtualExecutive::next_event_after_dispatch() const {
   std::int64_t t = kNever;
-  bool polling = false;
   for (std::size_t i = 0; i < tasks_.size(); ++i) {
     const Slot& s = slots_[i];
     const Task& task = *tasks_[i];
     if (!s.job.active && s.next_release_ns >= 0) t = std::min(t, s.next_release_ns);
     if (s.job.active && !s.job.started && s.job.wait_until_ns > now_ns_) t = std::min(t, s.job.wait_until_ns);
     if (!s.server.refills.empty()) t = std::min(t, s.server.refills.front().first);
-    polling = polling || (!task.periodic() && task.state() == TaskState::kOn && task.trigger().fd >= 0);
+    const bool watching = !task.periodic() && task.state() == TaskState::kOn && task.trigger().fd >= 0;
+    if (watching && !s.job.active && s.events == 0) t = std::min(t, std::max(s.next_fd_poll_ns, now_ns_ + 1));
   }
   for (const int r : running_)
     if (r >= 0) t = std::min(t, now_ns_ + slots_[static_cast<std::size_t>(r)].job.remaining_ns);
-  if (polling) t = std::min(t, std::max(next_poll_ns_, now_ns_ + 1));
   return t;
 }
 
@@ -203,14 +204,22 @@ void VirtualExecutive::step() {
   dispatch();
 }
 
-void VirtualExecutive::run_until(std::int64_t end_ns) {
+bool VirtualExecutive::run_until(std::int64_t end_ns, const std::atomic<std::uint32_t>* watch) {
+  const std::uint32_t seen = watch != nullptr ? watch->load(std::memory_order_acquire) : 0;  // acquire: the request
   for (;;) {
     step();
+    if (watch != nullptr && watch->load(std::memory_order_acquire) != seen) return false;  // acquire: as above
     const std::int64_t t = next_event_after_dispatch();
     if (t >= end_ns) break;
     advance_to(t);
   }
   if (end_ns > now_ns_) advance_to(end_ns);
+  return true;
+}
+
+Result<void> VirtualExecutive::reinit(std::size_t task) {
+  if (tasks_[task]->reinit(now_ns_)) return {};
+  return make_error(Errc::kModuleFault, tasks_[task]->name() + ": reinit failed; the task is no longer ON");
 }
 
 void VirtualExecutive::end_open_job(std::size_t i) {
@@ -248,7 +257,7 @@ Result<void> VirtualExecutive::signal(std::size_t task, Signal signal) {
     }
     if (t.spec().server && s.server.refills.empty() && s.server.budget_ns <= 0)
       s.server.budget_ns = t.spec().server->budget_ns;
-    next_poll_ns_ = std::min(next_poll_ns_, now_ns_);
+    s.next_fd_poll_ns = now_ns_;
   }
   return r;
 }

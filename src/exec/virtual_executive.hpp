@@ -10,6 +10,7 @@
 // preempted meanwhile, and publishes its outputs when it ends. With no simulated time a job
 // starts and ends at its release, in policy order.
 
+#include <atomic>
 #include <cstdint>
 #include <vector>
 
@@ -30,12 +31,16 @@ class VirtualExecutive {
   /// (as on the real clock, where signals are handled between cycles).
   Result<void> signal(std::size_t task, Signal signal);
   /// Runs every event before `end_ns`, then sets the time to `end_ns` (jobs in progress keep
-  /// their remaining time).
-  void run_until(std::int64_t end_ns);
+  /// their remaining time). With `watch`, stops early at the first instant after which its value
+  /// has changed (a task asked for a switch), and returns false. Real-time safe.
+  bool run_until(std::int64_t end_ns, const std::atomic<std::uint32_t>* watch = nullptr);
+  /// reinit() of task `task` at the current simulated time.
+  Result<void> reinit(std::size_t task);
   /// A new plan (MUF's critical set after a switch), from the next dispatch on.
   void set_plan(SchedulePlan plan) { plan_ = std::move(plan); }
 
-  /// How often descriptors of aperiodic tasks are polled when nothing else happens.
+  /// How often the descriptor of an idle aperiodic task is polled while it has nothing to read;
+  /// after a job it is polled again at once (the descriptor is level-triggered).
   static constexpr std::int64_t kPollPeriodNs = 1'000'000;
 
  private:
@@ -59,9 +64,10 @@ class VirtualExecutive {
     std::int64_t first_release_ns = 0;       // periodic: the first release since it turned on
     std::int64_t last_done_release_ns = -1;  // the release of the last job that ended
     std::int64_t job_start_ns = 0;
-    std::uint64_t events = 0;        // aperiodic: events not served yet
-    std::uint64_t seen_version = 0;  // aperiodic, update trigger: the variable's version served
-    int trigger_var = -1;            // aperiodic, update trigger: the variable's index
+    std::uint64_t events = 0;          // aperiodic: events not served yet
+    std::int64_t next_fd_poll_ns = 0;  // aperiodic, descriptor trigger: when to look at it again
+    std::uint64_t seen_version = 0;    // aperiodic, update trigger: the variable's version served
+    int trigger_var = -1;              // aperiodic, update trigger: the variable's index
     Server server;
   };
 
@@ -86,7 +92,6 @@ class VirtualExecutive {
   std::vector<int> running_;   // per CPU slot (index into plan_.cpu values via cpu_slot_): task or -1
   std::vector<int> cpu_slot_;  // per task: index into running_
   std::int64_t now_ns_ = 0;
-  std::int64_t next_poll_ns_ = 0;
 };
 
 }  // namespace chimera

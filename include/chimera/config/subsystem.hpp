@@ -65,6 +65,15 @@ struct ConfigurationSpec {
   SourceLoc loc;
 };
 
+/// A switch that a task may ask for while the subsystem runs (paper 3.4: a signal that a dynamic
+/// reconfiguration is required), e.g. a singularity monitor asking for damped least squares.
+struct SwitchRequestSpec {
+  std::string from;  // the configuration that must be on; "" for any
+  std::string to;    // the configuration asked for
+  std::string by;    // the task that may ask; "" for any
+  SourceLoc loc;
+};
+
 struct SubsystemSpec {
   std::string name;
   std::string file;
@@ -75,6 +84,15 @@ struct SubsystemSpec {
   std::vector<TaskSpec> tasks;
   std::vector<ConfigurationSpec> configurations;
   std::string start;  // a configuration name; the loader fills in the first when absent
+  std::vector<SwitchRequestSpec> requests;
+
+  /// The entry that lets task `by` ask for `to` while `from` is on, or nullptr.
+  [[nodiscard]] const SwitchRequestSpec* find_request(std::string_view from, std::string_view to,
+                                                      std::string_view by) const {
+    for (const auto& r : requests)
+      if (r.to == to && (r.from.empty() || r.from == from) && (r.by.empty() || r.by == by)) return &r;
+    return nullptr;
+  }
 
   [[nodiscard]] const TaskSpec* find_task(std::string_view task_name) const {
     for (const auto& t : tasks)

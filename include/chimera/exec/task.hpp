@@ -13,6 +13,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "chimera/config/verify.hpp"
 #include "chimera/core/result.hpp"
@@ -30,6 +31,10 @@ class Task {
   static constexpr std::size_t kEventCapacity = 64;
 
   Task(const ResolvedTask& resolved, GlobalTable& table, const SubsystemFlags& flags);
+  /// Whether the task has an in-const bound to variable `name`.
+  [[nodiscard]] bool reads_const(std::string_view name) const;
+  /// The names of the variables its out-consts are bound to.
+  [[nodiscard]] std::vector<std::string> const_outputs() const;
   ~Task();
   Task(const Task&) = delete;
   Task& operator=(const Task&) = delete;
@@ -69,6 +74,12 @@ class Task {
   std::int64_t end_job(std::int64_t end_ns, std::int64_t used_ns) noexcept;
   /// Whether a job has begun and not yet ended.
   [[nodiscard]] bool job_open() const noexcept { return job_.open; }
+  /// A producer of one of its in-consts changed its value (a switch): the new values are read
+  /// into the local table, then reinit(); a failure takes the error path. Between cycles only,
+  /// on the task's thread. Returns whether the task is still ON. Real-time safe for the framework.
+  bool reinit(std::int64_t now_ns) noexcept;
+  /// How many times reinit() ran since spawn.
+  [[nodiscard]] std::uint64_t reinits() const noexcept { return reinits_.load(std::memory_order_relaxed); }
   /// `n` releases that will not run (late: skip), each a missed deadline; a hard task gets
   /// error(). Real-time safe.
   void skip_releases(std::uint64_t n, std::int64_t now_ns) noexcept;
@@ -80,6 +91,8 @@ class Task {
   void set_exec_clock(ExecClock clock) noexcept { exec_clock_ = clock; }
   /// Marks the subsystem's clock as virtual in the timing modules see (set before spawn).
   void set_virtual_clock(bool is_virtual) noexcept { virtual_clock_ = is_virtual; }
+  /// Where its module's switch requests go, and its index there (set before spawn).
+  void set_request_board(RequestBoard* board, int index) noexcept { services_ = {board, index}; }
 
   [[nodiscard]] const TaskStats& stats() const { return stats_; }
   /// The executive gave up waiting for a same-rate producer. Real-time safe.
@@ -121,6 +134,7 @@ class Task {
   std::unique_ptr<LocalTable> local_;
   CycleTiming timing_;
   Trigger trigger_;
+  TaskServices services_;
   ExecClock exec_clock_ = ExecClock::kWall;
   bool virtual_clock_ = false;
   struct Job {
@@ -131,6 +145,7 @@ class Task {
     std::int64_t exec_start = 0;  // on exec_clock_
   } job_;
   std::uint64_t timing_faults_ = 0;  // recovered ones too: events are sent at 1, 2, 4, 8...
+  std::atomic<std::uint64_t> reinits_{0};
   TaskStats stats_;
   EventRing<kEventCapacity> events_;
   std::array<char, 160> exception_text_{};

@@ -150,7 +150,7 @@ TEST_F(CliTest, RunRepliesToBadCommandsAndGoesOn) {
   EXPECT_TRUE(contains(o.out, "unknown command 'bogus' (try help)\n")) << o.out;
   EXPECT_TRUE(contains(o.out, "unknown task 'nosuch'\n")) << o.out;
   EXPECT_TRUE(contains(o.out, "theta_m is produced by task 'robot'")) << o.out;
-  EXPECT_TRUE(contains(o.out, "unknown command 'switch' (try help)\n")) << o.out;
+  EXPECT_TRUE(contains(o.out, ": no configuration named other (configurations: pid_control)\n")) << o.out;
   EXPECT_TRUE(contains(o.out, "theta_d = [")) << o.out;
 }
 

@@ -239,6 +239,24 @@ TEST_F(ControlTest, StatsIsTheTimingTable) {
   EXPECT_NE(r.text.find("counter"), std::string::npos);
 }
 
+TEST_F(ControlTest, StatsOfOneTaskIsItsProfile) {
+  subsystem_->run_for(10 * kMs);
+  const Reply r = run("stats counter");
+  ASSERT_TRUE(r.ok) << r.text;
+  EXPECT_EQ(r.text.rfind("counter (test_counter), ON, cpu ", 0), 0U) << r.text;
+  EXPECT_NE(r.text.find("  cycles 10, missed 0, overruns 0, skipped 0"), std::string::npos) << r.text;
+  EXPECT_NE(r.text.find("execution time:\n  <= "), std::string::npos) << r.text;
+  // On the virtual clock every release starts on time: one bucket, all ten cycles, a full bar.
+  EXPECT_NE(r.text.find("release latency:\n  <=       0 ns        10  ########################################\n"),
+            std::string::npos)
+      << r.text;
+  const Reply spare = run("stats spare");
+  EXPECT_NE(spare.text.find("execution time:\n  (no cycles yet)\n"), std::string::npos) << spare.text;
+  const Reply bad = run("stats nosuch");
+  EXPECT_FALSE(bad.ok);
+  EXPECT_EQ(bad.text, "unknown task 'nosuch'\n");
+}
+
 TEST_F(ControlTest, HelpUnknownAndBlankLines) {
   const Reply help = run("help");
   for (const char* verb : {"status", "spawn", "on", "off", "kill", "clear", "get", "set", "wait", "stats", "quit"})

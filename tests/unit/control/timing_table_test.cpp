@@ -19,6 +19,7 @@ std::vector<TaskSnapshot> sample() {
   pid.module = "pid_joint";
   pid.state = TaskState::kOn;
   pid.period_ns = 1'000'000;
+  pid.cpu = 1;
   pid.stats.cycles = 2000;
   pid.stats.missed = 3;
   pid.stats.exec_mean_ns = 12'345;
@@ -75,9 +76,9 @@ TEST(StatusTable, OneRowPerTask) {
   const auto text = status_table(sample());
   const auto lines = lines_of(text);
   ASSERT_EQ(lines.size(), 3U);
-  EXPECT_EQ(lines[0], "task  module          state        period  cycles  missed");
-  EXPECT_EQ(lines[1], "pid   pid_joint       ON             1 ms    2000       3");
-  EXPECT_EQ(lines[2], "traj  joint_traj_gen  NOT-CREATED   10 ms       0       0");
+  EXPECT_EQ(lines[0], "task  module          state        cpu  period  cycles  missed");
+  EXPECT_EQ(lines[1], "pid   pid_joint       ON             1    1 ms    2000       3");
+  EXPECT_EQ(lines[2], "traj  joint_traj_gen  NOT-CREATED    0   10 ms       0       0");
 }
 
 TEST(StatusTable, ShowsTheLastErrorWhenThereIsOne) {
