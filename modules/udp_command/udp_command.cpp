@@ -3,8 +3,6 @@
 // publishes the numbers it holds. Run it under a sporadic server (`server:` in the file) so that
 // a flood of datagrams can never take more than its share of the processor.
 
-#include <arpa/inet.h>
-#include <netinet/in.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -16,6 +14,7 @@
 #include <string>
 
 #include "chimera/module/registry.hpp"
+#include "net/udp_socket.hpp"
 
 namespace chimera::modules {
 namespace {
@@ -60,9 +59,6 @@ class UdpCommand final : public Module {
  protected:
   Status init(InitContext& ctx) override {
     const Params& p = ctx.params();
-    const double port = p.number("port");
-    if (!(port >= 0 && port <= 65535) || port != std::floor(port))
-      return Status::fail("udp_command: port must be a whole number from 0 to 65535");
     const double size = p.number("size", kDefaultSize);
     if (!(size >= 1 && size <= kMaxSize) || size != std::floor(size))
       return Status::fail("udp_command: size must be a whole number from 1 to 256");
@@ -70,23 +66,15 @@ class UdpCommand final : public Module {
     if (!(cost >= 0)) return Status::fail("udp_command: cost must be >= 0 s");
     cost_ns_ = static_cast<std::int64_t>(std::llround(cost * 1e9));
 
-    sockaddr_in addr{};
-    addr.sin_family = AF_INET;
-    addr.sin_port = htons(static_cast<std::uint16_t>(port));
-    if (::inet_pton(AF_INET, p.text("address", "127.0.0.1").c_str(), &addr.sin_addr) != 1)
-      return Status::fail("udp_command: address is not an IPv4 address");
-    fd_ = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
-    if (fd_ < 0) return Status::fail("udp_command: cannot create a UDP socket");
-    if (::bind(fd_, reinterpret_cast<const sockaddr*>(&addr), sizeof(addr)) != 0)  // NOLINT: the sockets API
-      return Status::fail("udp_command: cannot bind the socket (address in use?)");
-    socklen_t len = sizeof(addr);
-    ::getsockname(fd_, reinterpret_cast<sockaddr*>(&addr), &len);  // NOLINT: the sockets API
+    const net::UdpSocket socket = net::bind_udp(p.text("address", "127.0.0.1"), p.number("port"));
+    if (socket.fd < 0) return Status::fail(socket.error);
+    fd_ = socket.fd;
 
     command_ = ctx.out<double>("command");
     stats_ = ctx.out<double>("command_stats");
     udp_port_ = ctx.out<double>("udp_port");
     if (ctx.failed()) return Status::ok();
-    udp_port_[0] = ntohs(addr.sin_port);
+    udp_port_[0] = socket.port;
     timing_ = &ctx.timing();
     ctx.trigger_on_fd(fd_);
     return Status::ok();

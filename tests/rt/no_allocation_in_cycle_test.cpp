@@ -2,6 +2,9 @@
 // counted and operator new fails by throwing. Cycles of the framework (transfers, statistics,
 // timing, dispatch) and of the Figure 4 modules, data logger included, run armed, on both clocks.
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -134,6 +137,50 @@ tasks:
   for (std::string line; std::getline(in, line);) ++lines;
   EXPECT_EQ(lines, 1u + 510u) << "a header and a row for each cycle: none lost, none failed";
   std::filesystem::remove(log);
+}
+
+// Figure 6's own modules: a replayed session and a UDP socket (read every cycle, with commands
+// arriving) feeding the Cartesian interpolation.
+TEST(NoAllocationInCycle, TheTeleoperationModules) {
+  auto s = started_virtual(R"(subsystem: teleop_alloc
+constants:
+  x_m: [0.5, 0, 0.5, 0, 0, 0.3]
+tasks:
+  - name: replay
+    module: teleop_input
+    period: 10ms
+    params: { source: replay, session: ['0.1 move 0.05 0 0', '0.2 vel 0 0.1 0 0 0 0.2', '0.4 goto 0.4 0 0.6 0 0 0'] }
+  - name: udp
+    module: teleop_input
+    period: 10ms
+    rename: { x_goal: x_goal_udp, teleop_stats: udp_stats }
+  - { name: interp, module: cartesian_interp, period: 1ms }
+)");
+  ASSERT_NE(s, nullptr);
+  const auto port = s->get("udp_stats");
+  ASSERT_TRUE(port.ok());
+  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+  ASSERT_GE(fd, 0);
+  sockaddr_in to{};
+  to.sin_family = AF_INET;
+  to.sin_port = htons(static_cast<std::uint16_t>((*port)[2]));
+  to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  long allocations = 0;
+  for (int i = 0; i < 10; ++i) {
+    const std::string command = i % 2 == 0 ? "move 0.01 0 0" : "nonsense";
+    // NOLINTNEXTLINE(cppcoreguidelines-pro-type-reinterpret-cast): the sockets API
+    (void)::sendto(fd, command.data(), command.size(), 0, reinterpret_cast<const sockaddr*>(&to), sizeof(to));
+    allocations += allocations_while_running(*s, 100 * kMs);
+  }
+  ::close(fd);
+  EXPECT_EQ(allocations, 0) << "allocations while teleoperating";
+  EXPECT_EQ(s->get("udp_stats")->at(0), 5.0) << "the datagrams were read";
+  s->run_for(1000 * kMs);
+  const auto x_d = s->get("x_d");
+  ASSERT_TRUE(x_d.ok());
+  EXPECT_NEAR((*x_d)[0], 0.4, 1e-12) << "the interpolation reached the replayed goto";
+  EXPECT_NEAR((*x_d)[2], 0.6, 1e-12);
+  for (const auto& t : s->snapshot()) EXPECT_EQ(t.state, TaskState::kOn) << t.name;
 }
 
 TEST(NoAllocationInCycle, Figure4WithSensorNoise) {
