@@ -20,7 +20,13 @@ class CartesianInterp final : public Module {
   static constexpr const char* kName = "cartesian_interp";
   static constexpr const char* kSummary = "Cartesian trajectory interpolation: x_d toward x_goal within speed limits";
   static constexpr const char* kDoc =
-      "Cartesian trajectory interpolation of the paper's Figure 6. Poses are [x y z rx ry rz]: m, and "
+      "The *Cartesian trajectory interpolator* of the paper's Figure 6 (Cartesian teleoperation): it\n"
+      "turns a goal pose that jumps (each command of an operator, from\n"
+      "[teleop_input](teleop_input.md)) into a desired tool pose `x_d` that moves smoothly toward it,\n"
+      "for inverse kinematics (`inv_kin`) or resolved-rate control (`damped_least_squares` and\n"
+      "`time_integrator`) to follow."
+      "\n\n"
+      "Poses are [x y z rx ry rz]: m, and "
       "a rotation vector in rad, in the arm's base frame. Turned on, x_d starts at the measured pose "
       "x_m, at rest. Each cycle of dt it moves toward the goal x_goal: the position along the straight "
       "line to the goal's, the orientation about the fixed axis of the shortest rotation to the "

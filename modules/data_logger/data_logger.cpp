@@ -73,7 +73,12 @@ class DataLogger final : public Module {
   static constexpr const char* kName = "data_logger";
   static constexpr const char* kSummary = "records chosen state variables to a CSV file (no outputs)";
   static constexpr const char* kDoc =
-      "The paper's data logger: a task that only gathers data, with one in-var port for each name in "
+      "The paper's *data logger* (section 3): a task that \"just gathers data\" and so has no output\n"
+      "ports. It records the variables it is given, every cycle, to a CSV file, without ever making\n"
+      "its real-time cycle wait, format or write: a ring allocated at init takes the rows, and an\n"
+      "ordinary thread writes them out."
+      "\n\n"
+      "One in-var port for each name in "
       "variables (a port takes the size its variable has elsewhere in the file; rename: binds a port "
       "to another variable). Each cycle it copies the release time t (s, on the subsystem's clock) "
       "and every element of every variable (nan before the variable has data) into a preallocated "

@@ -63,8 +63,13 @@ class TeleopInput final : public Module {
   static constexpr const char* kName = "teleop_input";
   static constexpr const char* kSummary = "Teleoperation input: operator commands (UDP or a recording) to a goal pose";
   static constexpr const char* kDoc =
-      "The teleoperation input of the paper's Figure 6. Its resource port takes an operator's "
-      "commands, one a line: `move dx dy dz [drx dry drz]` steps the goal (m; rad about the base "
+      "The *teleoperation input* of the paper's Figure 6 (Cartesian teleoperation). Its **resource\n"
+      "port** takes an operator's commands, from UDP datagrams (sent by `chimera-teleop` from its\n"
+      "command line, the keyboard or a recording) or from a recorded session replayed on the\n"
+      "subsystem's clock, and turns them into the goal pose `x_goal` that\n"
+      "[cartesian_interp](cartesian_interp.md) moves the tool toward."
+      "\n\n"
+      "Commands, one a line: `move dx dy dz [drx dry drz]` steps the goal (m; rad about the base "
       "axes), `goto x y z rx ry rz` sets it, `vel vx vy vz [wx wy wz]` moves it at that velocity (m/s, "
       "rad/s) until `stop`, another command, or timeout seconds without a command (a dead man's "
       "switch), `hold` puts it where the tool is (x_m), `home` where the tool was at the first cycle. "

@@ -2,9 +2,6 @@
 // counted and operator new fails by throwing. Cycles of the framework (transfers, statistics,
 // timing, dispatch) and of the Figure 4 modules, data logger included, run armed, on both clocks.
 
-#include <arpa/inet.h>
-#include <netinet/in.h>
-#include <sys/socket.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -18,6 +15,7 @@
 #include "chimera/exec/subsystem.hpp"
 #include "support/allocation_guard.hpp"
 #include "support/probe_module.hpp"
+#include "support/udp_sender.hpp"
 
 namespace chimera {
 namespace {
@@ -159,20 +157,12 @@ tasks:
   ASSERT_NE(s, nullptr);
   const auto port = s->get("udp_stats");
   ASSERT_TRUE(port.ok());
-  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
-  ASSERT_GE(fd, 0);
-  sockaddr_in to{};
-  to.sin_family = AF_INET;
-  to.sin_port = htons(static_cast<std::uint16_t>((*port)[2]));
-  to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  const testing::UdpSender sender(static_cast<int>((*port)[2]));
   long allocations = 0;
   for (int i = 0; i < 10; ++i) {
-    const std::string command = i % 2 == 0 ? "move 0.01 0 0" : "nonsense";
-    // NOLINTNEXTLINE(cppcoreguidelines-pro-type-reinterpret-cast): the sockets API
-    (void)::sendto(fd, command.data(), command.size(), 0, reinterpret_cast<const sockaddr*>(&to), sizeof(to));
+    ASSERT_TRUE(sender.send(i % 2 == 0 ? "move 0.01 0 0" : "nonsense"));
     allocations += allocations_while_running(*s, 100 * kMs);
   }
-  ::close(fd);
   EXPECT_EQ(allocations, 0) << "allocations while teleoperating";
   EXPECT_EQ(s->get("udp_stats")->at(0), 5.0) << "the datagrams were read";
   s->run_for(1000 * kMs);

@@ -2,11 +2,6 @@
 // on time, the dead man's switch, the reach limit, UDP datagrams, refusals; the interpolation from
 // where the tool is toward the goal; and the two chained, as in Figure 6.
 
-#include <arpa/inet.h>
-#include <netinet/in.h>
-#include <sys/socket.h>
-#include <unistd.h>
-
 #include <array>
 #include <cmath>
 #include <memory>
@@ -19,6 +14,7 @@
 #include "chimera/exec/subsystem.hpp"
 #include "chimera/module/registry.hpp"
 #include "support/probe_module.hpp"
+#include "support/udp_sender.hpp"
 
 namespace chimera {
 namespace {
@@ -117,23 +113,12 @@ TEST_F(TeleopTest, DatagramsAreCommandsAndNonsenseIsCounted) {
   ASSERT_EQ(stats.size(), 3u);
   ASSERT_GT(stats[2], 0) << "the port the system chose";
 
-  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
-  ASSERT_GE(fd, 0);
-  sockaddr_in to{};
-  to.sin_family = AF_INET;
-  to.sin_port = htons(static_cast<std::uint16_t>(stats[2]));
-  to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  auto send = [&](const std::string& text) {
-    // NOLINTNEXTLINE(cppcoreguidelines-pro-type-reinterpret-cast): the sockets API
-    ASSERT_EQ(::sendto(fd, text.data(), text.size(), 0, reinterpret_cast<const sockaddr*>(&to), sizeof(to)),
-              static_cast<ssize_t>(text.size()));
-  };
-  // On loopback a datagram is in the socket when sendto returns: the next cycle reads it.
-  send("move 0.01 0 0\nmove 0.01 0 0\n");
-  send("jump");
-  send("move 0 0 -0.02 0 0 -0.3");
+  const testing::UdpSender sender(static_cast<int>(stats[2]));
+  // On loopback a datagram is in the socket when it is sent: the next cycle reads it.
+  ASSERT_TRUE(sender.send("move 0.01 0 0\nmove 0.01 0 0\n"));
+  ASSERT_TRUE(sender.send("jump"));
+  ASSERT_TRUE(sender.send("move 0 0 -0.02 0 0 -0.3"));
   s->run_for(10 * kMs);
-  ::close(fd);
   expect_pose(get(*s, "x_goal"), {0.52, 0, 0.48, 0, 0, 0}, 1e-12, "three moves");
   EXPECT_EQ(get(*s, "teleop_stats"), (std::vector<double>{3, 1, stats[2]}));
 }
