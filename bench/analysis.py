@@ -236,7 +236,7 @@ def cycle(doc, plots):
     pid = _d(doc, "cycle_overhead", "pid_joint_cycle_with_framework_ns")
     out = ["## Framework cost per cycle", "",
            f"**{F(c)}** per cycle of Figure 4's PID task, goal <= 1 µs: "
-           f"{'met' if c <= 1000 else 'missed'}. `Task::run_cycle` with a module that has `pid_joint`'s ports "
+           f"{'met' if c <= 1000 else 'missed'}. `Task::begin_job` and `end_job` with a module that has `pid_joint`'s ports "
            "and an empty `cycle()`: pull four 6-double in-vars that are new every cycle, push `tau_r`, two "
            "clock reads for the execution time, the statistics (`bench/cycle_bench.cpp`, the producers' "
            "writes subtracted). Not included: the kernel's wake-up, which the release latency above "

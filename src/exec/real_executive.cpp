@@ -189,12 +189,16 @@ Result<void> RealExecutive::start_thread(Worker& w) {
   return {};
 }
 
-Result<void> RealExecutive::post(Worker& w, Mail mail) {
+std::uint32_t RealExecutive::send(Worker& w, const Mail& mail) {
   w.mail = mail;
   const std::uint32_t seq = w.request_seq.load(std::memory_order_relaxed) + 1;  // only this thread writes it
   w.request_seq.store(seq, std::memory_order_release);                          // release: publishes `mail`
   detail::futex_wake_all(w.request_seq);
   ring_bell(w);  // an aperiodic task may be asleep on its event source instead
+  return seq;
+}
+
+Result<void> RealExecutive::await(Worker& w, std::uint32_t seq) {
   const std::int64_t give_up = monotonic_ns() + kReplyTimeoutNs;
   for (;;) {
     const std::uint32_t done = w.done_seq.load(std::memory_order_acquire);  // acquire: see `reply`
@@ -210,6 +214,18 @@ Result<void> RealExecutive::post(Worker& w, Mail mail) {
     w.running = false;
   }
   return r;
+}
+
+Result<void> RealExecutive::post(Worker& w, Mail mail) { return await(w, send(w, mail)); }
+
+Result<void> RealExecutive::post_all(const std::vector<std::size_t>& indices, const std::vector<Mail>& mails) {
+  std::vector<std::uint32_t> seqs;
+  seqs.reserve(indices.size());
+  for (std::size_t n = 0; n < indices.size(); ++n) seqs.push_back(send(*workers_[indices[n]], mails[n]));
+  Result<void> first;
+  for (std::size_t n = 0; n < indices.size(); ++n)
+    if (auto r = await(*workers_[indices[n]], seqs[n]); !r && first) first = r;
+  return first;
 }
 
 Result<void> RealExecutive::signal(std::size_t index, Signal sig) {
@@ -233,9 +249,28 @@ Result<void> RealExecutive::commit_switch(const std::vector<std::size_t>& leavin
   // Every leaving task answers once it is off: after its last release before the commit. Only
   // then may a joining task turn on, since on() publishes outputs a leaving task wrote: one
   // writer per variable at any time.
-  for (const std::size_t i : leaving)
-    if (auto r = post(*workers_[i], Mail{MailKind::kLeaveAt, Signal::kOff, epoch_ns_ + commit_ns}); !r) return r;
-  return turn_on_locked(joining, commit_ns);
+  // Successors of the joining tasks must wait for them from the commit's release on, even if the
+  // commit runs late: tell them before anything changes.
+  for (const std::size_t i : joining) {
+    Worker& w = *workers_[i];
+    if (w.task->periodic())
+      w.joining_k.store((commit_ns + w.task->period_ns() - 1) / w.task->period_ns(), std::memory_order_release);
+  }
+  const std::vector<Mail> leave(leaving.size(), Mail{MailKind::kLeaveAt, Signal::kOff, epoch_ns_ + commit_ns});
+  Result<void> r = post_all(leaving, leave);
+  // Each joining task turns on right before its first release from the commit on, on its own
+  // thread: not earlier, since on() publishes outputs a consumer may still be reading the leaving
+  // producer's last value of. They are all posted at once and answer as each turns on.
+  std::vector<Mail> join;
+  for (const std::size_t i : joining) {
+    const Worker& w = *workers_[i];
+    const std::int64_t p = w.task->periodic() ? w.task->period_ns() : 1;
+    join.push_back(Mail{MailKind::kOnAt, Signal::kOn, (std::max(commit_ns, now_ns()) + p - 1) / p});
+  }
+  if (auto on = post_all(joining, join); r && !on) r = on;
+  for (const std::size_t i : joining)
+    workers_[i]->joining_k.store(-1, std::memory_order_release);  // scheduled says it now
+  return r;
 }
 
 void RealExecutive::set_plan(const SchedulePlan& plan) {

@@ -65,6 +65,11 @@ class RealExecutive {
   Result<void> start_thread(Worker& w);
   /// Posts `mail` to a task's thread and waits for its answer. Not real-time safe.
   Result<void> post(Worker& w, Mail mail);
+  /// Posts `mail` to several tasks' threads at once, then waits for every answer.
+  Result<void> post_all(const std::vector<std::size_t>& indices, const std::vector<Mail>& mails);
+  /// Posts only; returns the sequence number of the answer to wait for.
+  std::uint32_t send(Worker& w, const Mail& mail);
+  Result<void> await(Worker& w, std::uint32_t seq);
   Result<void> turn_on_locked(const std::vector<std::size_t>& indices, std::int64_t not_before_ns);
 
   std::vector<std::unique_ptr<PriorityDispatcher>> dispatchers_;  // outlive the workers that poke them

@@ -55,6 +55,10 @@ void Worker::main() {
       if (!handle(req, k)) return;
       continue;
     }
+    if (on_at >= 0) {
+      (void)join_at_release(req, k);
+      continue;
+    }
     if (task->state() != TaskState::kOn) {
       scheduled.store(-1, std::memory_order_release);  // release: successors stop waiting on us
       if (bell_fd >= 0) {
@@ -104,10 +108,19 @@ bool Worker::handle(std::uint32_t seq, std::int64_t& k) {
                   : make_error(Errc::kModuleFault, task->name() + ": reinit failed; the task is no longer ON");
       reply_to(seq);
       return task->state() != TaskState::kNotCreated;
+    case MailKind::kOnAt:
+      // Turned on at its first release, not now: on() publishes its outputs, and a consumer may
+      // still be reading the leaving producer's last value of the release before.
+      if (task->periodic() && task->state() == TaskState::kOff) {
+        on_at = mail.at;
+        on_seq = seq;
+        return true;
+      }
+      break;
     case MailKind::kSignal:
     case MailKind::kOnHeld: break;
   }
-  const Signal request = mail.kind == MailKind::kOnHeld ? Signal::kOn : mail.signal;
+  const Signal request = mail.kind == MailKind::kSignal ? mail.signal : Signal::kOn;
   // A task turning on joins the grid at the next whole multiple of its period. Successors must
   // see that release as scheduled as soon as they can see the task ON, or one of them could run
   // its shared release without waiting for it: publish it before the state changes. (A held
@@ -126,6 +139,25 @@ bool Worker::handle(std::uint32_t seq, std::int64_t& k) {
   const bool alive = task->state() != TaskState::kNotCreated;
   reply_to(seq);
   return alive;
+}
+
+bool Worker::join_at_release(std::uint32_t req, std::int64_t& k) {
+  const std::int64_t release_abs = exec->epoch_ns() + on_at * task->period_ns();
+  if (monotonic_ns() < release_abs) {
+    detail::futex_wait(request_seq, req, release_abs);
+    return false;
+  }
+  const std::uint32_t seq = on_seq;
+  scheduled.store(on_at, std::memory_order_release);  // release: successors wait for this release
+  reply = task->apply(Signal::kOn, exec->now_ns());
+  if (task->state() == TaskState::kOn) {
+    k = on_at;
+    on_turned_on();
+  }
+  on_at = -1;
+  on_seq = 0;
+  reply_to(seq);
+  return true;
 }
 
 void Worker::leave() {
@@ -279,10 +311,14 @@ void Worker::wait_for_predecessors(std::int64_t k, std::int64_t release_abs) con
   const std::int64_t give_up = std::max(release_abs, monotonic_ns()) + task->spec().deadline_ns / 2;
   for (Worker* p : predecessors) {
     for (;;) {
-      if (reached(p->completed.load(std::memory_order_acquire), k)) break;  // acquire: its cycle is done
-      if (p->task->state() != TaskState::kOn) break;
-      const std::int64_t s = p->scheduled.load(std::memory_order_acquire);  // acquire: pairs with its store
-      if (s < 0 || s > k) break;                           // not released, or joined after this instant
+      if (reached(p->completed.load(std::memory_order_acquire), k)) break;      // acquire: its cycle is done
+      const std::int64_t joins = p->joining_k.load(std::memory_order_acquire);  // acquire: pairs with the commit
+      const bool joining = joins >= 0 && joins <= k;
+      if (!joining) {
+        if (p->task->state() != TaskState::kOn) break;
+        const std::int64_t s = p->scheduled.load(std::memory_order_acquire);  // acquire: pairs with its store
+        if (s < 0 || s > k) break;  // not released, or joined after this instant
+      }
       p->waiters.fetch_add(1, std::memory_order_seq_cst);  // seq_cst: Dekker with the producer (see run_periodic)
       const std::uint32_t c = p->completed.load(std::memory_order_seq_cst);
       bool in_time = true;

@@ -26,6 +26,7 @@ enum class MailKind : std::uint8_t {
   kJoin,     // first release at index `at`, set by the control thread for every task of a group
   kLeaveAt,  // turn off before the first release at or after absolute time `at`; reply once off
   kReinit,   // an in-const changed: reinit() between two cycles
+  kOnAt,     // a switch: turn on right before release index `at` and run it; reply once on
 };
 
 struct Mail {
@@ -60,6 +61,10 @@ struct Worker {
   alignas(64) std::atomic<std::uint32_t> completed{0};
   std::atomic<std::uint32_t> waiters{0};
   std::atomic<std::int64_t> scheduled{-1};  // release index about to run; -1 when not released
+  // A switch's commit: the release this (still OFF) task will join at; -1 when none. Successors
+  // wait for it at that release as if it were ON, so that a commit running late cannot make them
+  // read the leaving producer's last value.
+  std::atomic<std::int64_t> joining_k{-1};
 
   // The job it publishes for its dispatcher (edf / muf), and its own thread handle for it.
   alignas(64) std::atomic<bool> job_active{false};
@@ -76,6 +81,8 @@ struct Worker {
   bool held = false;            // ON, but waiting for kJoin before its first release
   std::int64_t leave_at = -1;   // absolute time: turn off before the first release at or after it
   std::uint32_t leave_seq = 0;  // the kLeaveAt request to answer once off (0: none)
+  std::int64_t on_at = -1;      // kOnAt: the release index to turn on right before (-1: none)
+  std::uint32_t on_seq = 0;     // the kOnAt request to answer once on
 
   // Sporadic server: touched only by the task's own thread.
   static constexpr std::size_t kMaxRefills = 64;
@@ -97,6 +104,9 @@ struct Worker {
   void reply_to(std::uint32_t seq);
   /// Turns off now for a pending kLeaveAt, and answers it.
   void leave();
+  /// A pending kOnAt: waits for its release, then turns on and answers. Returns true once on
+  /// (or refused), false while it still waits.
+  bool join_at_release(std::uint32_t req, std::int64_t& k);
   void run_periodic(std::uint32_t seq, std::int64_t& k);
   void run_aperiodic(std::uint32_t seq);
   void wait_for_predecessors(std::int64_t k, std::int64_t release_abs) const;
