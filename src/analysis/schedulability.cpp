@@ -15,7 +15,7 @@ namespace {
 
 using detail::duration_text;
 
-constexpr std::string_view kBackgroundReason = "aperiodic without a server: runs in the background, no guarantee";
+constexpr std::string_view kBackgroundReason = "aperiodic without a server: runs when nothing else does";
 
 std::string unknown_reason(const TaskModel& t) {
   if (t.server && t.wcet_ns > 0) return "execution time unknown: the longest job of the server (give the task a wcet)";
@@ -115,19 +115,6 @@ void analyse_fixed_priority(std::span<const TaskModel> tasks, const std::vector<
   }
 }
 
-// Why an EDF test failed, in one line.
-std::string edf_reason(const EdfTest& test) {
-  switch (test.outcome) {
-    case EdfOutcome::kFeasible: return {};
-    case EdfOutcome::kOverloaded: return fmt::format("overloaded: U = {:.3f} > 1", test.utilisation);
-    case EdfOutcome::kDemandExceeded:
-      return fmt::format("processor demand {} of the jobs due in the first {} exceeds it",
-                         duration_text(test.demand_ns), duration_text(test.interval_ns));
-    case EdfOutcome::kGaveUp: return "the interval the processor-demand test must check could not be bounded";
-  }
-  return {};
-}
-
 // Deadline order, then file order: how EDF favours tasks released together.
 std::vector<std::size_t> deadline_order(std::span<const TaskModel> tasks) {
   std::vector<std::size_t> order;
@@ -166,7 +153,7 @@ void analyse_edf(std::span<const TaskModel> tasks, const std::vector<std::option
       r.response_is_bound = true;
     } else {
       // EDF gives no task a guarantee once the CPU fails its test: any job can be the one late.
-      r.reason = edf_reason(cpu.edf);
+      r.reason = edf_failure_reason(cpu.edf);
     }
     cpu.tasks.push_back(std::move(r));
   }
@@ -201,14 +188,13 @@ void analyse_muf(std::span<const TaskModel> tasks, const std::vector<std::option
       } else {
         std::vector<Demand> with = fitting;
         with.push_back(*r.demand);
-        r.reason = "hard, but does not fit in the critical set: with it, " + edf_reason(edf_test(with));
+        r.reason = "hard, but does not fit in the critical set: with it, " + edf_failure_reason(edf_test(with));
       }
     } else {
       r.verdict = Verdict::kNoGuarantee;
-      r.reason = !set.feasible ? "not critical, and the hard tasks already do not fit: no guarantee"
-                 : !r.demand   ? "not critical (" + unknown_reason(tasks[i]) + "): no guarantee"
-                               : "not critical: the critical set, shortest periods first, ends before it; no "
-                                 "guarantee";
+      r.reason = !set.feasible ? "outside the critical set: the hard tasks already do not fit"
+                 : !r.demand   ? "outside the critical set: " + unknown_reason(tasks[i])
+                               : "outside the critical set, which admits the shortest periods first while they fit";
     }
     (r.critical ? critical : others).push_back(std::move(r));
   }
@@ -218,6 +204,18 @@ void analyse_muf(std::span<const TaskModel> tasks, const std::vector<std::option
 }
 
 }  // namespace
+
+std::string edf_failure_reason(const EdfTest& test) {
+  switch (test.outcome) {
+    case EdfOutcome::kFeasible: return {};
+    case EdfOutcome::kOverloaded: return fmt::format("overloaded: U = {:.3f} > 1", test.utilisation);
+    case EdfOutcome::kDemandExceeded:
+      return fmt::format("the jobs due in the first {} need {}", duration_text(test.interval_ns),
+                         duration_text(test.demand_ns));
+    case EdfOutcome::kGaveUp: return "the interval the processor-demand test must check could not be bounded";
+  }
+  return {};
+}
 
 std::string_view verdict_name(Verdict verdict) {
   switch (verdict) {

@@ -26,6 +26,9 @@ enum class Verdict {
 
 std::string_view verdict_name(Verdict verdict);
 
+/// Why an EDF test failed, in one line ("overloaded: U = 1.100 > 1"); "" if it passed.
+std::string edf_failure_reason(const EdfTest& test);
+
 /// Which test decided a CPU.
 enum class CpuTest {
   kNone,                // no task with a period on the CPU
