@@ -63,7 +63,7 @@ Analysed analyse_one(const SubsystemSpec& spec, const ConfigurationSpec& config,
   std::string note;
   if (needs_measuring(analysis::task_models(spec, config.tasks, profile))) {
     const std::int64_t length = measurement_length_ns(spec, config.name);
-    auto run = measure_profile(spec, config.name, ClockKind::kVirtual, length, analysis::kMeasuredMargin);
+    auto run = measure_profile(spec, config.name, ClockKind::kVirtual, length, kMeasureRuns, analysis::kMeasuredMargin);
     if (!run) {
       fmt::print(stderr, "{}: configuration '{}': cannot run it to measure execution times: {}\n", spec.file,
                  config.name, run.error().message);
@@ -71,9 +71,9 @@ Analysed analyse_one(const SubsystemSpec& spec, const ConfigurationSpec& config,
     }
     measured = *std::move(run);
     note = fmt::format(
-        "measured: C = {} x the longest cycle seen in {} of the virtual clock (chimera profile and "
-        "--wcet-from give better figures)",
-        analysis::kMeasuredMargin, format_period(length));
+        "measured: C = {} x the longest cycle, the least of {} runs of {} on the virtual clock "
+        "(chimera profile and --wcet-from give better figures)",
+        analysis::kMeasuredMargin, kMeasureRuns, format_period(length));
   }
   const auto models = analysis::task_models(spec, config.tasks, profile, measured ? &*measured : nullptr);
   const auto result = analysis::analyse_configuration(models, cpu_of, cpus, spec.scheduler, options);
