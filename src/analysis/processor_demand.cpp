@@ -90,8 +90,8 @@ EdfTest edf_test(std::span<const Demand> tasks) {
   std::int64_t d_min = kMax;
   for (const auto& t : tasks) d_min = std::min(d_min, t.d_ns);
   auto t = deadline_before(tasks, r.bound_ns);
-  for (; t; ++r.points) {
-    if (r.points > kMaxSteps) return r;  // kGaveUp
+  while (t) {
+    if (++r.points > kMaxSteps) return r;  // kGaveUp
     const std::int64_t h = processor_demand(tasks, *t);
     if (h > *t) {
       r.outcome = EdfOutcome::kDemandExceeded;

@@ -170,7 +170,9 @@ TEST_F(AnalyzeTest, MeasuresTasksWithoutWcet) {
   const auto o = analyze(data("analyze_measured.yaml"));
   // Periods of 1 s and 2 s: even a cycle stretched by the machine's worst stall fits.
   EXPECT_EXIT_CODE(o, 0);
-  EXPECT_TRUE(contains(o.out, "measured: C = 1.5 x the longest cycle, the least of 5 runs of 40 s on the virtual clock")) << o.out;
+  EXPECT_TRUE(
+      contains(o.out, "measured: C = 1.5 x the longest cycle, the least of 5 runs of 40 s on the virtual clock"))
+      << o.out;
   EXPECT_TRUE(contains(row_of(o.out, "slow"), " measured ")) << o.out;
   EXPECT_TRUE(contains(row_of(o.out, "slower"), " measured ")) << o.out;
   EXPECT_TRUE(contains(row_of(o.out, "slower"), "meets")) << o.out;

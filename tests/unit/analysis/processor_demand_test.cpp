@@ -52,14 +52,19 @@ TEST(EdfTest, ConstrainedDeadlinesFeasible) {
   EXPECT_EQ(r.outcome, EdfOutcome::kFeasible);
   EXPECT_FALSE(r.utilisation_decides);
   EXPECT_GT(r.bound_ns, 0);
-  EXPECT_LE(r.bound_ns, 26);  // min(busy period, 25 rounded up)
-  EXPECT_GT(r.points, 0);
+  // The synchronous busy period 7 -> 9 -> 11 -> 14 -> 16 is shorter than the bound 25 of George
+  // et al.; QPA then visits 13, h = 11, h = 9, h = 7 = t, then the deadline before it, 5, where
+  // h(5) = 4 <= the shortest deadline: feasible.
+  EXPECT_EQ(r.bound_ns, 16);
+  EXPECT_EQ(r.points, 5);
 }
 
 TEST(EdfTest, ConstrainedDeadlinesInfeasibleBelowFullUtilisation) {
   // The same set with the third deadline at 6: h(6) = 2 + 2 + 3 = 7 > 6, though U = 0.917.
+  // QPA: 15 (h 14), 14 (11), 11 (9), 9 (7), 7 (7 = t), then the deadline 6: h(6) = 7.
   const auto r = edf_test(std::vector<Demand>{{2, 6, 4}, {2, 8, 5}, {3, 9, 6}});
   EXPECT_EQ(r.outcome, EdfOutcome::kDemandExceeded);
+  EXPECT_EQ(r.points, 6);
   EXPECT_EQ(r.interval_ns, 6);
   EXPECT_EQ(r.demand_ns, 7);
   // Two tasks due at 3 with 2 each, at U = 0.4.

@@ -22,7 +22,7 @@ std::vector<ResponseTime> all_response_times(const std::vector<Demand>& tasks) {
 }
 
 TEST(ResponseTime, AboveTheLiuLaylandBoundButFeasible) {
-  // Buttazzo, Hard Real-Time Computing Systems, ch. 4 (RTA): (C, T) = (1, 4), (2, 6), (3, 10).
+  // Buttazzo, Hard Real-Time Computing Systems, exercise 4.3: (C, T) = (1, 4), (2, 6), (3, 10).
   // U = 0.883 > 0.780, yet R3 = 10 <= 10: 6 -> 7 -> 9 -> 10 -> 10.
   const std::vector<Demand> tasks{{1, 4, 4}, {2, 6, 6}, {3, 10, 10}};
   EXPECT_GT(utilisation(tasks), liu_layland_bound(3));
@@ -47,7 +47,8 @@ TEST(ResponseTime, BurnsAndWellingsThreeTasksEndExactlyAtTheDeadline) {
 }
 
 TEST(ResponseTime, InfeasibleUnderRateMonotonic) {
-  // Liu and Layland's (and Buttazzo's) RM-versus-EDF set: (2, 5), (4, 7), U = 0.971.
+  // Buttazzo's RM-versus-EDF set ("Rate monotonic vs. EDF: judgment day", 2005): (2, 5), (4, 7),
+  // U = 0.971.
   // R2: 6 -> 8 -> 8 > 7.
   const auto r = all_response_times({{2, 5, 5}, {4, 7, 7}});
   EXPECT_EQ(r[0].outcome, RtaOutcome::kMeets);

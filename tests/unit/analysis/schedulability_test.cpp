@@ -31,7 +31,7 @@ std::vector<std::size_t> order_of(const CpuResult& cpu) {
 }
 
 TEST(AnalyseCpu, RateMonotonicAboveTheBoundIsFeasible) {
-  // Buttazzo's RTA example, listed out of priority order in the "file".
+  // Buttazzo's exercise 4.3, listed out of priority order in the "file".
   const std::vector<TaskModel> tasks{task("c", 3, 10, 0), task("a", 1, 4, 1), task("b", 2, 6, 2)};
   const auto cpu = analyse_cpu(tasks, SchedulerKind::kRm, kNoOverhead);
   EXPECT_TRUE(cpu.feasible);
