@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <numeric>
 
+#include "chimera/analysis/response_time.hpp"
 #include "chimera/analysis/schedulability.hpp"
 #include "chimera/analysis/utilisation.hpp"
 
@@ -21,23 +22,74 @@ double share(const TaskModel& t, const AnalysisOptions& options) {
   return d ? static_cast<double>(d->c_ns) / static_cast<double>(d->t_ns) : 0.0;
 }
 
-// Whether `cpu` stays schedulable with `task` added. The sufficient tests first, since this runs
-// for every task and CPU: Liu and Layland under rm or dm with D = T, U <= 1 under edf with D >= T.
+// Fixed priorities: whether every task's response-time bound (Bini and Baruah) is within
+// min(D, T). O(n log n), from sums per priority rank; tasks of one rank interfere both ways.
+bool bounded_by_deadlines(std::span<const TaskModel> tasks, SchedulerKind scheduler, const AnalysisOptions& options) {
+  const auto ranks = fixed_priority_ranks(tasks, scheduler);
+  const int levels = ranks.empty() ? 0 : *std::max_element(ranks.begin(), ranks.end()) + 1;
+  std::vector<double> u(static_cast<std::size_t>(levels) + 1, 0.0);  // per rank, then prefix sums
+  std::vector<double> w(u.size(), 0.0);                              // sum C (1 - U) likewise
+  std::vector<Demand> demands;
+  demands.reserve(tasks.size());
+  for (std::size_t i = 0; i < tasks.size(); ++i) {
+    demands.push_back(*demand_of(tasks[i], options));
+    const double ui = static_cast<double>(demands[i].c_ns) / static_cast<double>(demands[i].t_ns);
+    u[static_cast<std::size_t>(ranks[i]) + 1] += ui;
+    w[static_cast<std::size_t>(ranks[i]) + 1] += static_cast<double>(demands[i].c_ns) * (1.0 - ui);
+  }
+  for (std::size_t r = 1; r < u.size(); ++r) {
+    u[r] += u[r - 1];
+    w[r] += w[r - 1];
+  }
+  for (std::size_t i = 0; i < tasks.size(); ++i) {
+    const auto level = static_cast<std::size_t>(ranks[i]) + 1;  // ranks 0 .. ranks[i], less the task itself
+    const Demand& d = demands[i];
+    const double ui = static_cast<double>(d.c_ns) / static_cast<double>(d.t_ns);
+    const double bound =
+        response_time_upper_bound(d.c_ns, u[level] - ui, w[level] - static_cast<double>(d.c_ns) * (1.0 - ui));
+    if (!(bound * (1.0 + 1e-9) <= static_cast<double>(std::min(d.d_ns, d.t_ns)))) return false;
+  }
+  return true;
+}
+
+// Whether `cpu` stays schedulable with `task` added. Sufficient tests first, since this runs for
+// every task and CPU, on the density sum C / min(D, T): a set is no harder than the same set with
+// every period and deadline cut to min(D, T). Where that keeps the priority order (rm with every
+// D >= T, dm with every D <= T), Liu and Layland's bound on the density suffices; for edf,
+// density <= 1; for muf the hard tasks' density <= 1, since soft tasks never make it infeasible.
+// For rm and dm, the response-time bound of Bini and Baruah next. Near the limits the exact
+// analysis decides.
 bool fits(const Cpu& cpu, const TaskModel& task, SchedulerKind scheduler, const AnalysisOptions& options) {
+  constexpr double kSafety = 1e-9;  // the sums are in floating point; the exact test settles the rest
   std::vector<TaskModel> with = cpu.known;
   with.push_back(task);
-  std::vector<Demand> demands;
-  bool implicit = true;
-  bool late = true;
+  double density = 0;
+  double hard_density = 0;
+  bool late = true;   // every D >= T
+  bool early = true;  // every D <= T
   for (const auto& t : with) {
-    demands.push_back(*demand_of(t, options));
-    implicit = implicit && relative_deadline(t) == t.period_ns;
-    late = late && relative_deadline(t) >= t.period_ns;
+    const Demand d = *demand_of(t, options);
+    const double share = static_cast<double>(d.c_ns) / static_cast<double>(std::min(d.d_ns, d.t_ns));
+    density += share;
+    if (t.hard) hard_density += share;
+    late = late && d.d_ns >= d.t_ns;
+    early = early && d.d_ns <= d.t_ns;
   }
-  if ((scheduler == SchedulerKind::kRm || scheduler == SchedulerKind::kDm) && implicit &&
-      utilisation(demands) <= liu_layland_bound(static_cast<int>(demands.size())))
-    return true;
-  if (scheduler == SchedulerKind::kEdf && late) return utilisation_at_most_one(demands);
+  const double bound = liu_layland_bound(static_cast<int>(with.size())) - kSafety;
+  switch (scheduler) {
+    case SchedulerKind::kRm:
+      if ((late && density <= bound) || bounded_by_deadlines(with, scheduler, options)) return true;
+      break;
+    case SchedulerKind::kDm:
+      if ((early && density <= bound) || bounded_by_deadlines(with, scheduler, options)) return true;
+      break;
+    case SchedulerKind::kEdf:
+      if (density <= 1.0 - kSafety) return true;
+      break;
+    case SchedulerKind::kMuf:
+      if (hard_density <= 1.0 - kSafety) return true;
+      break;
+  }
   return analyse_cpu(with, scheduler, options).feasible;
 }
 

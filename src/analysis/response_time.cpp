@@ -81,6 +81,11 @@ ResponseTime response_time(const Demand& task, std::span<const Demand> interfere
   return r;
 }
 
+double response_time_upper_bound(std::int64_t c_ns, double interference_utilisation, double interference_weighted_c) {
+  if (interference_utilisation >= 1.0) return std::numeric_limits<double>::infinity();
+  return (static_cast<double>(c_ns) + interference_weighted_c) / (1.0 - interference_utilisation);
+}
+
 std::vector<int> fixed_priority_ranks(std::span<const TaskModel> tasks, SchedulerKind scheduler) {
   std::vector<std::int64_t> keys;
   for (const auto& t : tasks)

@@ -35,6 +35,14 @@ struct ResponseTime {
 /// equal priority, the task itself excluded) can preempt it. Integer arithmetic, exact.
 [[nodiscard]] ResponseTime response_time(const Demand& task, std::span<const Demand> interference);
 
+/// Bini and Baruah (2007): a bound on the response time of the first job after the critical
+/// instant, (C + sum_j C_j (1 - U_j)) / (1 - sum_j U_j) over the interfering tasks j, from two sums
+/// a caller can keep as prefix sums. Infinity when sum_j U_j >= 1. Where it is at most min(D, T),
+/// every job meets its deadline (the busy period ends before the next release); it is a cheap
+/// sufficient test, the exact answer is response_time().
+[[nodiscard]] double response_time_upper_bound(std::int64_t c_ns, double interference_utilisation,
+                                               double interference_weighted_c);
+
 /// The rank of each task's priority under rm (by period) or dm (by relative deadline): 0 is the
 /// highest. Tasks with equal periods (rm) or deadlines (dm) share a rank: they run in data-flow
 /// order at a shared release (the same-rate rule, docs/architecture.md) whatever their place in
