@@ -41,6 +41,16 @@ TEST(AssignCpus, SkipsALessLoadedCpuWhereTheTaskWouldMiss) {
   EXPECT_EQ(assign_cpus(tasks, std::vector<int>{0, 1}, SchedulerKind::kRm, kNoOverhead), (std::vector<int>{0, 1, 0}));
 }
 
+TEST(AssignCpus, ShortDeadlinesUnderRateMonotonicGetTheExactCheck) {
+  // urgent (1, T 200, D 2) has a density of only 0.5, yet under rm the pinned (2, 10) on the
+  // less-loaded CPU 0 outranks it: 1 + 2 = 3 > 2. On CPU 1 it outranks the pinned (100, 400).
+  // Under dm it outranks both, and CPU 0 is fine.
+  std::vector<TaskModel> tasks{task("ctl", 2, 10, 0, 0), task("slow", 100, 400, 1, 1), task("urgent", 1, 200, 2)};
+  tasks[2].deadline_ns = 2;
+  EXPECT_EQ(assign_cpus(tasks, std::vector<int>{0, 1}, SchedulerKind::kRm, kNoOverhead), (std::vector<int>{0, 1, 1}));
+  EXPECT_EQ(assign_cpus(tasks, std::vector<int>{0, 1}, SchedulerKind::kDm, kNoOverhead), (std::vector<int>{0, 1, 0}));
+}
+
 TEST(AssignCpus, NowhereFeasibleGoesToTheLeastLoaded) {
   const std::vector<TaskModel> tasks{task("a", 9, 10, 0), task("b", 8, 10, 1), task("c", 5, 10, 2)};
   EXPECT_EQ(assign_cpus(tasks, std::vector<int>{0, 1}, SchedulerKind::kEdf, kNoOverhead), (std::vector<int>{0, 1, 1}));
