@@ -8,7 +8,7 @@
 #include "chimera/analysis/task_model.hpp"
 #include "chimera/exec/subsystem.hpp"
 
-namespace CLI {
+namespace CLI {  // NOLINT(readability-identifier-naming): CLI11's namespace, forward-declared
 class App;
 }  // namespace CLI
 
