@@ -25,14 +25,15 @@ DEMO_CMD ?= scripts/demo.sh $(BUILD_DIR) 5
 FORMAT_DIRS := include src modules sim apps tests bench
 TIDY_DIRS ?= src
 
-.PHONY: help setup setup-lint build test check demo bench format format-check tidy clean
+.PHONY: help setup setup-lint setup-bench build build-bench test check demo bench bench-quick format format-check tidy clean
 
 help:
 	@echo "make demo          install missing packages, build, run the demo (DEMO_CMD)"
 	@echo "make test          build and test $(BUILD_DIR)/, then ASAN+UBSAN ($(ASAN_DIR)/) and TSAN ($(TSAN_DIR)/)"
 	@echo "make build         configure and build $(BUILD_DIR)/ ($(BUILD_TYPE), Ninja, ccache if present)"
 	@echo "make check         only the sanitizer trees of make test"
-	@echo "make bench         Release build in $(BENCH_DIR)/ with the benchmarks, then run them"
+	@echo "make bench         Release build in $(BENCH_DIR)/, run every benchmark (~5 min), write bench/results/latest.{json,md}"
+	@echo "make bench-quick   the same, short (under a minute once built); report in $(BENCH_DIR)/bench-results/quick/"
 	@echo "make format        clang-format the sources in place; format-check only reports"
 	@echo "make tidy          clang-tidy over $(TIDY_DIRS)/ (fails on any finding)"
 	@echo "make setup         install the missing Debian packages (scripts/packages.txt)"
@@ -46,6 +47,10 @@ setup:
 setup-lint:
 	@bash scripts/setup.sh lint
 
+# The benchmarks' peers (iceoryx, Cyclone DDS): an optional group, so that `make test` never installs them.
+setup-bench:
+	@bash scripts/setup.sh bench
+
 build: setup
 	@bash scripts/build.sh $(BUILD_DIR) -DCMAKE_BUILD_TYPE=$(BUILD_TYPE)
 
@@ -58,15 +63,15 @@ check: setup
 demo: build
 	$(DEMO_CMD)
 
-bench: setup
+build-bench: setup-bench
 	@bash scripts/build.sh $(BENCH_DIR) -DCMAKE_BUILD_TYPE=Release -DCHIMERA_BUILD_BENCH=ON -DCHIMERA_BUILD_TESTS=OFF
-	@if [[ -x bench/run.sh ]]; then \
-	  bench/run.sh $(BENCH_DIR); \
-	elif [[ -x $(BENCH_DIR)/bench/svt_bench ]]; then \
-	  $(BENCH_DIR)/bench/svt_bench; \
-	else \
-	  echo "bench: neither bench/run.sh nor $(BENCH_DIR)/bench/svt_bench exists yet" >&2; exit 1; \
-	fi
+
+# Not run by CI. The committed bench/results/ are the latest full run.
+bench: build-bench
+	@bench/run.sh $(BENCH_DIR)
+
+bench-quick: build-bench
+	@bench/run.sh $(BENCH_DIR) --quick
 
 # Sources to format: found on disk (not from git), so new files are included before they are committed.
 format_files = $(shell find $(FORMAT_DIRS) -type f \( -name '*.hpp' -o -name '*.cpp' -o -name '*.inl' -o -name '*.h' -o -name '*.cc' \) 2>/dev/null | sort)

@@ -34,9 +34,6 @@ constexpr std::int64_t kStepNs = 50'000'000;
 constexpr int kPollMs = 50;
 constexpr std::string_view kPrompt = "chimera> ";
 
-// The number of dynamic reconfigurations; `switch` comes with a later issue.
-constexpr std::uint64_t kSwitches = 0;
-
 void out(std::string_view text) {
   std::fwrite(text.data(), 1, text.size(), stdout);
   std::fflush(stdout);  // replies must reach a script reading the pipe as they happen
@@ -183,6 +180,7 @@ int run_command(const RunArgs& args) {
 
   // The figures as they stood while the tasks ran; stopping turns every task NOT-CREATED.
   const auto tasks = subsystem.snapshot();
+  const std::uint64_t switches = subsystem.switches().size();
   subsystem.stop();
   Control control(subsystem);
   out(control.drain_events());
@@ -190,7 +188,7 @@ int run_command(const RunArgs& args) {
 
   int code = subsystem.hard_task_failed() ? kExitFailed : kExitOk;
   if (args.stats_json) {
-    if (auto written = write_stats_json(*args.stats_json, tasks, args.clock, kSwitches); !written) {
+    if (auto written = write_stats_json(*args.stats_json, tasks, args.clock, switches); !written) {
       fmt::print(stderr, "{}\n", written.error().message);
       code = std::max(code, kExitFailed);
     }

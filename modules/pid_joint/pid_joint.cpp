@@ -1,9 +1,11 @@
 // pid_joint: the PID joint position controller of the paper's Figure 4.
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <string_view>
 
+#include "chimera/module/fault_tolerance.hpp"
 #include "chimera/module/registry.hpp"
 #include "pid_law.hpp"
 
@@ -27,6 +29,8 @@ Vector per_joint(const Params& p, std::string_view name, Vector fallback, std::s
     if (!std::isfinite(x) || x < 0.0) v.clear();
   return v;
 }
+
+constexpr double kDefaultLateLimit = 100;
 
 class PidJoint final : public Module {
  public:
@@ -58,6 +62,8 @@ class PidJoint final : public Module {
     d.param("kd", default_kd(), "N*m*s/rad", "derivative gains, on the velocity error");
     d.param("tau_max", default_tau_max(), "N*m", "output saturation per joint");
     d.param("i_max", default_i_max(), "rad*s", "bound on the integral of the position error");
+    d.param("late_limit", kDefaultLateLimit, "cycles",
+            "timing faults (late cycles, budget overruns) in a row that error() recovers from before ERROR");
   }
 
  protected:
@@ -85,8 +91,14 @@ class PidJoint final : public Module {
     if (g.kp.empty() || g.ki.empty() || g.kd.empty() || g.tau_max.empty() || g.i_max.empty())
       return Status::fail("pid_joint: kp, ki, kd, tau_max and i_max need ndof (or 1) values, none negative");
     law_.configure(std::move(g), dt);
+    timing_ = &ctx.timing();
+    tolerance_ =
+        TimingFaultTolerance(static_cast<std::uint64_t>(std::max(1.0, p.number("late_limit", kDefaultLateLimit))));
     return Status::ok();
   }
+
+  // A late torque update is only late: recover, unless the lateness goes on (see late_limit).
+  Status error() override { return tolerance_.judge(*timing_); }
 
   // A new producer of ndof took over: fine as long as the arm has as many joints as before.
   Status reinit() override {
@@ -132,6 +144,8 @@ class PidJoint final : public Module {
   In<double> dtheta_m_;
   Out<double> tau_r_;
   PidLaw law_;
+  const CycleTiming* timing_ = nullptr;
+  TimingFaultTolerance tolerance_{static_cast<std::uint64_t>(kDefaultLateLimit)};
 };
 
 CHIMERA_REGISTER_MODULE(PidJoint);

@@ -1,6 +1,7 @@
 // robot_torque: the torque-mode robot interface of the paper's Figure 4. Its resource port is a
 // MuJoCo simulation of a 6-joint arm; a real arm's driver would take the same place.
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <memory>
@@ -8,6 +9,7 @@
 #include <set>
 #include <string>
 
+#include "chimera/module/fault_tolerance.hpp"
 #include "chimera/module/registry.hpp"
 #include "chimera/sim/arm_sim.hpp"
 
@@ -16,6 +18,7 @@ namespace {
 
 constexpr double kDefaultNdof = 6.0;
 constexpr int kMaxNdof = 64;
+constexpr double kDefaultLateLimit = 100;
 
 // Status carries only static strings; a message built at init (with a path or a count) is kept
 // here for the life of the program. Each distinct message is stored once.
@@ -65,6 +68,8 @@ class RobotTorque final : public Module {
     d.param("noise_std", 0.0, "rad", "standard deviation of Gaussian noise on theta_m");
     d.param("seed", 1.0, "", "seed of the measurement noise (runs repeat exactly)");
     d.param("initial", Vector(n, 0.0), "rad", "joint positions at init");
+    d.param("late_limit", kDefaultLateLimit, "cycles",
+            "timing faults (late cycles, budget overruns) in a row that error() recovers from before ERROR");
     d.resource("MuJoCo simulation of a PUMA 560-like 6-joint arm (sim/models/arm6.xml), stepped by the task's period");
   }
 
@@ -107,8 +112,15 @@ class RobotTorque final : public Module {
       return Status::fail("robot_torque: port sizes differ from parameter ndof");
     ndof_out[0] = n;
     publish();
+    timing_ = &ctx.timing();
+    tolerance_ =
+        TimingFaultTolerance(static_cast<std::uint64_t>(std::max(1.0, p.number("late_limit", kDefaultLateLimit))));
     return Status::ok();
   }
+
+  // The simulated arm steps by the period whenever the cycle runs, so a late cycle is only late:
+  // recover, unless the lateness goes on (late_limit). A real arm's driver would be stricter.
+  Status error() override { return tolerance_.judge(*timing_); }
 
   Status on() override {
     sim_->set_torque({});  // nothing is applied until a controller speaks
@@ -161,6 +173,8 @@ class RobotTorque final : public Module {
   Out<double> dtheta_m_;
   std::int64_t period_ns_ = 0;
   Vector initial_;
+  const CycleTiming* timing_ = nullptr;
+  TimingFaultTolerance tolerance_{static_cast<std::uint64_t>(kDefaultLateLimit)};
 };
 
 CHIMERA_REGISTER_MODULE(RobotTorque);

@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "config/detail/request_loader.hpp"
 #include "config/detail/task_loader.hpp"
 #include "config/detail/yaml_reader.hpp"
 
@@ -190,7 +191,7 @@ Result<MapReader> read_document(const Source& source, std::string_view text) {
                                          config_detail::describe(root.node)));
   return MapReader::create(
       source, root, "the file",
-      {"subsystem", "scheduler", "cpus", "plugins", "constants", "tasks", "configurations", "start"});
+      {"subsystem", "scheduler", "cpus", "plugins", "constants", "tasks", "configurations", "start", "requests"});
 }
 
 Result<SubsystemSpec> load(const Source& source, std::string_view text, const Registry& registry) {
@@ -208,6 +209,7 @@ Result<SubsystemSpec> load(const Source& source, std::string_view text, const Re
   if (auto ok = read_tasks(source, *top, registry, spec); !ok) return ok.error();
   if (auto ok = read_configurations(source, *top, spec); !ok) return ok.error();
   if (auto ok = read_start(source, *top, spec); !ok) return ok.error();
+  if (auto ok = config_detail::read_requests(source, top->get("requests"), spec); !ok) return ok.error();
   return spec;
 }
 

@@ -20,4 +20,12 @@ std::string_view criticality_name(Criticality c) {
   return "?";
 }
 
+std::string_view late_policy_name(LatePolicy p) {
+  switch (p) {
+    case LatePolicy::kRun: return "run";
+    case LatePolicy::kSkip: return "skip";
+  }
+  return "?";
+}
+
 }  // namespace chimera

@@ -34,10 +34,12 @@ constexpr std::array kVerbs{
     VerbSpec{Verb::kOff, "off", 1, kMany, "off TASK..", "deactivate tasks (off): ON -> OFF"},
     VerbSpec{Verb::kKill, "kill", 1, 1, "kill TASK", "destroy a task (off if ON, then kill): -> NOT-CREATED"},
     VerbSpec{Verb::kClear, "clear", 1, 1, "clear TASK", "the fault is fixed (clear): ERROR -> OFF"},
+    VerbSpec{Verb::kSwitch, "switch", 1, 1, "switch CONFIG",
+             "dynamic reconfiguration to another configuration of the file, at a cycle boundary"},
     VerbSpec{Verb::kGet, "get", 1, 1, "get VAR", "the current value of a state variable"},
     VerbSpec{Verb::kSet, "set", 2, kMany, "set VAR V..", "write a variable that no ON task produces"},
     VerbSpec{Verb::kWait, "wait", 1, 1, "wait DURATION", "let the subsystem run (e.g. 500ms) before the next command"},
-    VerbSpec{Verb::kStats, "stats", 0, 0, "stats", "the timing table"},
+    VerbSpec{Verb::kStats, "stats", 0, 1, "stats [TASK]", "the timing table, or one task's profile (histograms)"},
     VerbSpec{Verb::kQuit, "quit", 0, 0, "quit", "stop the subsystem cleanly (every task: off, then kill)"},
     VerbSpec{Verb::kHelp, "help", 0, 0, "help", "this list"},
 };
@@ -83,6 +85,9 @@ std::string arity_message(const VerbSpec& v) {
   if (v.max_args == 0) return fmt::format("{} takes no arguments (usage: {})", v.name, v.syntax);
   if (v.min_args == v.max_args)
     return fmt::format("{} takes {} argument{} (usage: {})", v.name, v.min_args, v.min_args == 1 ? "" : "s", v.syntax);
+  if (v.max_args != kMany)
+    return fmt::format("{} takes at most {} argument{} (usage: {})", v.name, v.max_args, v.max_args == 1 ? "" : "s",
+                       v.syntax);
   return fmt::format("{} takes at least {} argument{} (usage: {})", v.name, v.min_args, v.min_args == 1 ? "" : "s",
                      v.syntax);
 }

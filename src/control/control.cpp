@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "chimera/control/task_profile.hpp"
 #include "chimera/control/timing_table.hpp"
 
 namespace chimera {
@@ -65,12 +66,23 @@ Reply Control::execute(const Command& command) {
   try {
     switch (command.verb) {
       case Verb::kStatus: return said(status_table(subsystem_.snapshot()));
-      case Verb::kStats: return said(timing_table(subsystem_.snapshot()));
+      case Verb::kStats: {
+        const auto tasks = subsystem_.snapshot();
+        if (command.args.empty()) return said(timing_table(tasks));
+        for (const auto& t : tasks)
+          if (t.name == command.args[0]) return said(task_profile(t));
+        return refused(fmt::format("unknown task '{}'", command.args[0]));
+      }
       case Verb::kSpawn:
       case Verb::kOn:
       case Verb::kOff:
       case Verb::kKill:
       case Verb::kClear: return signal_tasks(signal_of(command.verb), command.args);
+      case Verb::kSwitch: {
+        auto record = subsystem_.switch_to(command.args.at(0));
+        if (!record) return refused(record.error().message);
+        return said(describe(*record) + "\n");
+      }
       case Verb::kGet: return get(command.args.at(0));
       case Verb::kSet: return set(command.args.at(0), command.values);
       case Verb::kWait: {

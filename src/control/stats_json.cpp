@@ -13,16 +13,29 @@ std::string stats_json(std::span<const TaskSnapshot> tasks, ClockKind clock, std
   // ordered_json keeps the tasks in file order, which is how people read them.
   using Json = nlohmann::ordered_json;
   Json per_task = Json::object();
+  auto histogram = [](const std::vector<std::pair<std::int64_t, std::uint64_t>>& buckets) {
+    Json out = Json::array();
+    for (const auto& [upper, count] : buckets) out.push_back(Json::array({upper, count}));
+    return out;
+  };
   for (const auto& t : tasks) {
     const auto& s = t.stats;
     per_task[t.name] = Json{
         {"module", t.module},
         {"state", std::string(state_name(t.state))},
+        {"cpu", t.cpu},
         {"period_ns", t.period_ns},
         {"cycles", s.cycles},
         {"missed", s.missed},
-        {"exec_ns", Json{{"mean", s.exec_mean_ns}, {"max", s.exec_max_ns}}},
+        {"overruns", s.overruns},
+        {"skipped", s.skipped},
+        {"order_timeouts", s.order_timeouts},
+        {"exec_ns",
+         Json{{"mean", s.exec_mean_ns}, {"p50", s.exec_p50_ns}, {"p99", s.exec_p99_ns}, {"max", s.exec_max_ns}}},
         {"latency_ns", Json{{"p50", s.latency_p50_ns}, {"p99", s.latency_p99_ns}, {"max", s.latency_max_ns}}},
+        {"response_ns", Json{{"p99", s.response_p99_ns}, {"max", s.response_max_ns}}},
+        // The profiles: [bucket upper bound in ns, count] for each bucket that holds records.
+        {"histograms", Json{{"exec_ns", histogram(s.exec_histogram)}, {"latency_ns", histogram(s.latency_histogram)}}},
     };
   }
   const Json doc{

@@ -56,10 +56,12 @@ std::string status_table(std::span<const TaskSnapshot> tasks) {
   for (const auto& t : tasks) any_error = any_error || !t.last_error.empty();
 
   auto columns = identity_columns();
+  columns.insert(columns.begin() + 3, {"cpu", Align::kRight});  // the assignment, pinned or automatic
   if (any_error) columns.push_back({"last error", Align::kLeft});
   TextTable table(std::move(columns));
   for (const auto& t : tasks) {
     auto cells = identity_cells(t);
+    cells.insert(cells.begin() + 3, fmt::format("{}", t.cpu));
     if (any_error) cells.push_back(t.last_error);
     table.add_row(std::move(cells));
   }
@@ -67,13 +69,24 @@ std::string status_table(std::span<const TaskSnapshot> tasks) {
 }
 
 std::string timing_table(std::span<const TaskSnapshot> tasks) {
+  // Timing failures other than late cycles get columns only when some task has them.
+  bool overruns = false;
+  bool skipped = false;
+  for (const auto& t : tasks) {
+    overruns = overruns || t.stats.overruns != 0;
+    skipped = skipped || t.stats.skipped != 0;
+  }
   auto columns = identity_columns();
+  if (overruns) columns.push_back({"overruns", Align::kRight});
+  if (skipped) columns.push_back({"skipped", Align::kRight});
   for (const char* header : {"exec mean", "exec max", "latency p50", "latency p99", "latency max"})
     columns.push_back({header, Align::kRight});
   TextTable table(std::move(columns));
   for (const auto& t : tasks) {
     auto cells = identity_cells(t);
     const auto& s = t.stats;
+    if (overruns) cells.push_back(fmt::format("{}", s.overruns));
+    if (skipped) cells.push_back(fmt::format("{}", s.skipped));
     // A task that never cycled has no figures; a dash says so better than "0 ns".
     auto figure = [&](std::int64_t ns) { return s.cycles == 0 ? std::string("-") : format_duration(ns); };
     for (std::int64_t ns : {s.exec_mean_ns, s.exec_max_ns, s.latency_p50_ns, s.latency_p99_ns, s.latency_max_ns})

@@ -2,21 +2,24 @@
 
 #include <pthread.h>
 #include <sched.h>
+#include <sys/eventfd.h>
 #include <sys/mman.h>
 #include <unistd.h>
 
 #include <algorithm>
-#include <array>
 #include <atomic>
-#include <cstring>
+#include <map>
 #include <set>
 #include <system_error>
+#include <tuple>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include "chimera/exec/clock.hpp"
 #include "futex.hpp"
+#include "priority_dispatcher.hpp"
+#include "real_worker.hpp"
 
 namespace chimera {
 
@@ -30,6 +33,9 @@ constexpr bool kSanitized = false;
 constexpr std::size_t kStackBytes = std::size_t{1} << 20;  // locked by mlockall: keep it modest
 #endif
 constexpr std::int64_t kReplyTimeoutNs = 10'000'000'000;
+constexpr int kTopFixedPriority = 80;
+constexpr int kLowestFixedPriority = 2;
+constexpr int kBackgroundPriority = 1;
 
 void warn_once(std::atomic<bool>& flag, const std::string& message) {
   if (!flag.exchange(true, std::memory_order_relaxed)) spdlog::warn("{}", message);  // a latch only
@@ -38,9 +44,28 @@ void warn_once(std::atomic<bool>& flag, const std::string& message) {
 std::atomic<bool> g_warned_fifo{false};   // NOLINT(cppcoreguidelines-avoid-non-const-global-variables): a latch
 std::atomic<bool> g_warned_mlock{false};  // NOLINT(cppcoreguidelines-avoid-non-const-global-variables): a latch
 
-// Release indices are compared modulo 2^32 (the futex word is 32 bits).
-bool reached(std::uint32_t completed_plus_one, std::int64_t k) {
-  return static_cast<std::int32_t>(completed_plus_one - static_cast<std::uint32_t>(k + 1)) >= 0;
+// Fixed priorities (rm, dm): one level per distinct key of the policy, the most urgent at
+// kTopFixedPriority. Tasks of one level share it; the same-rate rule orders them by data flow.
+std::vector<int> fixed_priorities(const SchedulePlan& plan) {
+  const std::size_t n = plan.urgency.size();
+  auto key = [&](std::size_t i) {
+    const TaskUrgency& u = plan.urgency[i];
+    return plan.policy == SchedulerKind::kDm ? std::pair{u.deadline_ns, u.period_ns} : std::pair{u.period_ns, 0L};
+  };
+  std::set<std::pair<std::int64_t, std::int64_t>> levels;
+  for (std::size_t i = 0; i < n; ++i)
+    if (!plan.urgency[i].background) levels.insert(key(i));
+  std::vector<int> out(n, kBackgroundPriority);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (plan.urgency[i].background) continue;
+    if (!is_fixed_priority(plan.policy)) {
+      out[i] = PriorityDispatcher::kReleasingPriority;  // edf / muf: ranked at each release
+      continue;
+    }
+    const auto rank = std::distance(levels.begin(), levels.find(key(i)));
+    out[i] = std::max(kLowestFixedPriority, kTopFixedPriority - static_cast<int>(rank));
+  }
+  return out;
 }
 
 }  // namespace
@@ -53,199 +78,130 @@ void prepare_realtime_process(bool realtime) {
                                           std::generic_category().message(errno)));
 }
 
-struct RealExecutive::Worker {
-  RealExecutive* exec = nullptr;
-  Task* task = nullptr;
-  std::vector<Worker*> predecessors;
-  int priority = 1;
-  cpu_set_t cpus{};
-  bool pinned = false;
-  pthread_t thread{};
-  bool running = false;
-
-  // Mailbox: written by the control thread, read by the task's thread.
-  alignas(64) std::atomic<std::uint32_t> request_seq{0};
-  Signal request = Signal::kSpawn;
-  // Reply: written by the task's thread, read by the control thread.
-  alignas(64) std::atomic<std::uint32_t> done_seq{0};
-  Result<void> reply;
-  // Precedence: the last release completed (+1, modulo 2^32), and how many successors sleep on it.
-  alignas(64) std::atomic<std::uint32_t> completed{0};
-  std::atomic<std::uint32_t> waiters{0};
-  std::atomic<std::int64_t> scheduled{-1};  // release index about to run; -1 when not released
-
-  void main();
-  bool handle(std::uint32_t seq, std::int64_t& k);
-  void wait_for_predecessors(std::int64_t k, std::int64_t release_abs) const;
-};
-
-void RealExecutive::Worker::main() {
-  // Touch the stack once so that its pages are resident before the first cycle.
-  std::array<char, std::size_t{64} * 1024> prefault;  // NOLINT(cppcoreguidelines-pro-type-member-init): written next
-  std::memset(prefault.data(), 0, prefault.size());
-  asm volatile("" : : "r"(prefault.data()) : "memory");  // keeps the compiler from dropping the writes
-
-  std::uint32_t seen = 0;
-  std::int64_t k = 0;
-  const std::int64_t period = task->period_ns();
-  for (;;) {
-    const std::uint32_t req = request_seq.load(std::memory_order_acquire);  // acquire: see `request`
-    if (req != seen) {
-      seen = req;
-      if (!handle(req, k)) return;
-      continue;
-    }
-    if (task->state() != TaskState::kOn || !task->periodic()) {
-      scheduled.store(-1, std::memory_order_release);  // release: successors stop waiting on us
-      detail::futex_wait(request_seq, req, -1);
-      continue;
-    }
-    const std::int64_t release_abs = exec->epoch_ns_ + k * period;
-    scheduled.store(k, std::memory_order_release);  // release: pairs with successors' acquire load
-    if (monotonic_ns() < release_abs) {
-      detail::futex_wait(request_seq, req, release_abs);
-      continue;  // a signal, a spurious wake, or the release: the loop tells which
-    }
-    wait_for_predecessors(k, release_abs);
-    const std::int64_t start = monotonic_ns();
-    task->run_cycle(release_abs - exec->epoch_ns_, start - exec->epoch_ns_, task->spec().deadline_ns, false);
-    // seq_cst store, then seq_cst load of `waiters`: with the successor's seq_cst increment and
-    // re-check this is Dekker's pattern, so either it sees our store or we see it waiting.
-    completed.store(static_cast<std::uint32_t>(k + 1), std::memory_order_seq_cst);
-    if (waiters.load(std::memory_order_seq_cst) != 0) detail::futex_wake_all(completed);
-    ++k;  // a late cycle runs late; the next release stays on the absolute grid
-  }
-}
-
-bool RealExecutive::Worker::handle(std::uint32_t seq, std::int64_t& k) {
-  const std::int64_t now = exec->now_ns();
-  const TaskState before = task->state();
-  reply = task->apply(request, now);
-  if (before != TaskState::kOn && task->state() == TaskState::kOn && task->periodic()) {
-    const std::int64_t p = task->period_ns();
-    k = (now + p - 1) / p;  // join the grid at the next whole multiple of the period
-  }
-  const bool alive = task->state() != TaskState::kNotCreated;
-  done_seq.store(seq, std::memory_order_release);  // release: publishes `reply`
-  detail::futex_wake_all(done_seq);
-  return alive;
-}
-
-void RealExecutive::Worker::wait_for_predecessors(std::int64_t k, std::int64_t release_abs) const {
-  // Bounded: a predecessor that keeps us waiting more than half our deadline no longer holds us
-  // back. Counted from when the wait starts, so that the order still holds while tasks catch up
-  // after a stall (when every release is already in the past).
-  const std::int64_t give_up = std::max(release_abs, monotonic_ns()) + task->spec().deadline_ns / 2;
-  for (Worker* p : predecessors) {
-    for (;;) {
-      if (reached(p->completed.load(std::memory_order_acquire), k)) break;  // acquire: its cycle is done
-      if (p->task->state() != TaskState::kOn) break;
-      const std::int64_t s = p->scheduled.load(std::memory_order_acquire);  // acquire: pairs with its store
-      if (s < 0 || s > k) break;                           // not released, or joined after this instant
-      p->waiters.fetch_add(1, std::memory_order_seq_cst);  // seq_cst: Dekker with the producer (see main)
-      const std::uint32_t c = p->completed.load(std::memory_order_seq_cst);
-      bool in_time = true;
-      if (!reached(c, k)) in_time = detail::futex_wait(p->completed, c, give_up);
-      p->waiters.fetch_sub(1, std::memory_order_relaxed);  // only a hint for the producer's wake
-      if (!in_time && monotonic_ns() >= give_up) {
-        task->record_order_timeout();
-        return;  // past the bound: run with what the table holds
-      }
-    }
-  }
-}
-
-RealExecutive::RealExecutive(const std::vector<Task*>& tasks, const ReleaseOrder& order, const SubsystemSpec& spec,
-                             bool realtime)
-    : epoch_ns_(monotonic_ns()), realtime_(realtime) {
-  // SCHED_FIFO priorities by rate: the shortest period gets the highest priority.
-  std::set<std::int64_t> periods;
-  for (Task* t : tasks)
-    if (t->periodic()) periods.insert(t->period_ns());
-  const long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
-  for (Task* t : tasks) {
+RealExecutive::RealExecutive(const std::vector<Task*>& tasks, const ReleaseOrder& order, const SchedulePlan& plan,
+                             bool realtime, const GlobalTable& table)
+    : table_(table), epoch_ns_(monotonic_ns()), realtime_(realtime) {
+  const std::vector<int> priorities = fixed_priorities(plan);
+  for (std::size_t i = 0; i < tasks.size(); ++i) {
     auto w = std::make_unique<Worker>();
     w->exec = this;
-    w->task = t;
-    const auto rank = t->periodic() ? std::distance(periods.begin(), periods.find(t->period_ns()))
-                                    : static_cast<long>(periods.size());
-    w->priority = std::max(1, 80 - static_cast<int>(rank));
-    CPU_ZERO(&w->cpus);
-    if (t->spec().cpu) {
-      CPU_SET(static_cast<unsigned>(*t->spec().cpu), &w->cpus);
-      w->pinned = true;
-    } else if (!spec.cpus.empty()) {
-      for (const int c : spec.cpus)
-        if (c < ncpu) CPU_SET(static_cast<unsigned>(c), &w->cpus);
-      w->pinned = true;
+    w->task = tasks[i];
+    w->index = i;
+    w->cpu = plan.cpu[i];
+    w->fixed_priority = priorities[i];
+    if (!tasks[i]->periodic()) {
+      w->bell_fd = ::eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK);
+      if (w->bell_fd < 0)
+        spdlog::error("{}: no eventfd ({}): the task will not wake for events", tasks[i]->name(),
+                      std::generic_category().message(errno));
     }
+    for (const auto& b : tasks[i]->resolved().bindings)
+      if (b.kind == PortKind::kOutVar)
+        if (auto v = table.find(b.variable)) w->out_vars.push_back(static_cast<int>(*v));
     workers_.push_back(std::move(w));
   }
-  for (std::size_t i = 0; i < workers_.size(); ++i)
+  for (std::size_t i = 0; i < workers_.size(); ++i) {
     for (const int p : order.predecessors[i])
       workers_[i]->predecessors.push_back(workers_[static_cast<std::size_t>(p)].get());
+    // Aperiodic tasks that read one of this task's outputs may be triggered by it.
+    for (std::size_t j = 0; j < workers_.size(); ++j) {
+      if (j == i || tasks[j]->periodic()) continue;
+      const auto& reads = tasks[j]->resolved().bindings;
+      const bool shares = std::any_of(reads.begin(), reads.end(), [&](const PortBinding& b) {
+        if (b.kind != PortKind::kInVar) return false;
+        const auto v = table.find(b.variable);
+        return v && std::find(workers_[i]->out_vars.begin(), workers_[i]->out_vars.end(), static_cast<int>(*v)) !=
+                        workers_[i]->out_vars.end();
+      });
+      if (shares) workers_[i]->subscribers.push_back(workers_[j].get());
+    }
+  }
+  if (!is_fixed_priority(plan.policy)) {
+    std::map<int, std::pair<std::vector<Worker*>, std::vector<TaskUrgency>>> per_cpu;
+    for (std::size_t i = 0; i < workers_.size(); ++i) {
+      if (plan.urgency[i].background) continue;
+      per_cpu[plan.cpu[i]].first.push_back(workers_[i].get());
+      per_cpu[plan.cpu[i]].second.push_back(plan.urgency[i]);
+    }
+    for (auto& [cpu, group] : per_cpu) {
+      auto d = std::make_unique<PriorityDispatcher>(cpu, plan.policy, group.first, group.second);
+      for (Worker* w : group.first) w->dispatcher = d.get();
+      d->start(realtime_);
+      dispatchers_.push_back(std::move(d));
+    }
+  }
 }
 
 RealExecutive::~RealExecutive() {
-  for (auto& w : workers_) {
-    if (w->running && w->task->state() != TaskState::kNotCreated)
-      (void)signal(static_cast<std::size_t>(&w - workers_.data()), Signal::kKill);
-    if (w->running) pthread_join(w->thread, nullptr);
+  for (std::size_t i = 0; i < workers_.size(); ++i) {
+    Worker& w = *workers_[i];
+    if (w.running && w.task->state() != TaskState::kNotCreated) (void)signal(i, Signal::kKill);
+    if (w.running) pthread_join(w.thread, nullptr);
   }
 }
 
 std::int64_t RealExecutive::now_ns() const { return monotonic_ns() - epoch_ns_; }
 
+int RealExecutive::fixed_priority(std::size_t index) const { return workers_[index]->fixed_priority; }
+
 namespace {
 void* worker_entry(void* arg) {
-  static_cast<RealExecutive::Worker*>(arg)->main();
+  static_cast<Worker*>(arg)->main();
   return nullptr;
 }
 }  // namespace
 
-Result<void> RealExecutive::signal(std::size_t index, Signal sig) {
-  std::lock_guard<std::mutex> lock(control_mutex_);
-  Worker& w = *workers_[index];
-  if (!w.running) {
-    if (sig != Signal::kSpawn) return w.task->apply(sig, now_ns());  // refused by the state table
-    pthread_attr_t attr;
-    pthread_attr_init(&attr);
-    pthread_attr_setstacksize(&attr, kStackBytes);
-    if (w.pinned) pthread_attr_setaffinity_np(&attr, sizeof(cpu_set_t), &w.cpus);
-    int rc = EPERM;
-    if (realtime_) {
-      sched_param sp{};
-      sp.sched_priority = w.priority;
-      pthread_attr_setinheritsched(&attr, PTHREAD_EXPLICIT_SCHED);
-      pthread_attr_setschedpolicy(&attr, SCHED_FIFO);
-      pthread_attr_setschedparam(&attr, &sp);
-      rc = pthread_create(&w.thread, &attr, worker_entry, &w);
-      if (rc == EPERM)
-        warn_once(g_warned_fifo,
-                  "SCHED_FIFO is not permitted here: tasks run as ordinary threads "
-                  "(run as root or grant CAP_SYS_NICE / an rtprio limit for real-time priorities)");
-    }
-    if (rc == EPERM) {
-      pthread_attr_setinheritsched(&attr, PTHREAD_INHERIT_SCHED);
-      rc = pthread_create(&w.thread, &attr, worker_entry, &w);
-    }
-    pthread_attr_destroy(&attr);
-    if (rc != 0)
-      return make_error(Errc::kSystem, fmt::format("{}: cannot start its thread: {}", w.task->name(),
-                                                   std::generic_category().message(rc)));
-    w.running = true;
+Result<void> RealExecutive::start_thread(Worker& w) {
+  pthread_attr_t attr;
+  pthread_attr_init(&attr);
+  pthread_attr_setstacksize(&attr, kStackBytes);
+  cpu_set_t cpus;
+  CPU_ZERO(&cpus);
+  CPU_SET(static_cast<unsigned>(w.cpu), &cpus);
+  // Partitioned scheduling needs real-time priorities; ordinary threads do better where the
+  // kernel balances them (pinned, they starve behind other load), unless the file pins them.
+  if (realtime_ || w.task->spec().cpu) pthread_attr_setaffinity_np(&attr, sizeof(cpu_set_t), &cpus);
+  int rc = EPERM;
+  if (realtime_) {
+    sched_param sp{};
+    sp.sched_priority = w.fixed_priority;
+    pthread_attr_setinheritsched(&attr, PTHREAD_EXPLICIT_SCHED);
+    pthread_attr_setschedpolicy(&attr, SCHED_FIFO);
+    pthread_attr_setschedparam(&attr, &sp);
+    w.current_priority.store(w.fixed_priority, std::memory_order_relaxed);  // before the thread exists
+    rc = pthread_create(&w.thread, &attr, worker_entry, &w);
+    if (rc == EPERM)
+      warn_once(g_warned_fifo,
+                "SCHED_FIFO is not permitted here: tasks run as ordinary threads, so priorities (and the edf "
+                "and muf policies) are not enforced (run as root or grant CAP_SYS_NICE / an rtprio limit)");
   }
-  w.request = sig;
+  if (rc == EPERM) {
+    pthread_attr_setinheritsched(&attr, PTHREAD_INHERIT_SCHED);
+    if (!w.task->spec().cpu && sched_getaffinity(0, sizeof(cpu_set_t), &cpus) == 0)
+      pthread_attr_setaffinity_np(&attr, sizeof(cpu_set_t), &cpus);  // ordinary threads: unpinned
+    rc = pthread_create(&w.thread, &attr, worker_entry, &w);
+  }
+  pthread_attr_destroy(&attr);
+  if (rc != 0)
+    return make_error(Errc::kSystem, fmt::format("{}: cannot start its thread: {}", w.task->name(),
+                                                 std::generic_category().message(rc)));
+  w.running = true;
+  return {};
+}
+
+Result<void> RealExecutive::post(Worker& w, Mail mail) {
+  w.mail = mail;
   const std::uint32_t seq = w.request_seq.load(std::memory_order_relaxed) + 1;  // only this thread writes it
-  w.request_seq.store(seq, std::memory_order_release);                          // release: publishes `request`
+  w.request_seq.store(seq, std::memory_order_release);                          // release: publishes `mail`
   detail::futex_wake_all(w.request_seq);
+  ring_bell(w);  // an aperiodic task may be asleep on its event source instead
   const std::int64_t give_up = monotonic_ns() + kReplyTimeoutNs;
   for (;;) {
     const std::uint32_t done = w.done_seq.load(std::memory_order_acquire);  // acquire: see `reply`
     if (done == seq) break;
     if (!detail::futex_wait(w.done_seq, done, give_up) && monotonic_ns() >= give_up)
-      return make_error(Errc::kModuleFault, fmt::format("{}: no answer to {} within 10 s (a method is stuck?)",
-                                                        w.task->name(), signal_name(sig)));
+      return make_error(Errc::kModuleFault,
+                        fmt::format("{}: no answer within 10 s (a method is stuck?)", w.task->name()));
   }
   Result<void> r = std::move(w.reply);
   w.reply = Result<void>{};
@@ -254,6 +210,74 @@ Result<void> RealExecutive::signal(std::size_t index, Signal sig) {
     w.running = false;
   }
   return r;
+}
+
+Result<void> RealExecutive::signal(std::size_t index, Signal sig) {
+  std::lock_guard<std::mutex> lock(control_mutex_);
+  Worker& w = *workers_[index];
+  if (!w.running) {
+    if (sig != Signal::kSpawn) return w.task->apply(sig, now_ns());  // refused by the state table
+    if (auto started = start_thread(w); !started) return started;
+  }
+  return post(w, Mail{MailKind::kSignal, sig, 0});
+}
+
+Result<void> RealExecutive::turn_on_together(const std::vector<std::size_t>& indices, std::int64_t not_before_ns) {
+  std::lock_guard<std::mutex> lock(control_mutex_);
+  return turn_on_locked(indices, not_before_ns);
+}
+
+Result<void> RealExecutive::commit_switch(const std::vector<std::size_t>& leaving,
+                                          const std::vector<std::size_t>& joining, std::int64_t commit_ns) {
+  std::lock_guard<std::mutex> lock(control_mutex_);
+  // Every leaving task answers once it is off: after its last release before the commit. Only
+  // then may a joining task turn on, since on() publishes outputs a leaving task wrote: one
+  // writer per variable at any time.
+  for (const std::size_t i : leaving)
+    if (auto r = post(*workers_[i], Mail{MailKind::kLeaveAt, Signal::kOff, epoch_ns_ + commit_ns}); !r) return r;
+  return turn_on_locked(joining, commit_ns);
+}
+
+void RealExecutive::set_plan(const SchedulePlan& plan) {
+  std::lock_guard<std::mutex> lock(control_mutex_);
+  for (auto& d : dispatchers_) {
+    std::vector<TaskUrgency> urgency;
+    for (const Worker* w : d->workers()) urgency.push_back(plan.urgency[w->index]);
+    d->set_urgency(urgency);
+  }
+}
+
+Result<void> RealExecutive::reinit(std::size_t index) {
+  std::lock_guard<std::mutex> lock(control_mutex_);
+  return post(*workers_[index], Mail{MailKind::kReinit, Signal::kOn, 0});
+}
+
+Result<void> RealExecutive::turn_on_locked(const std::vector<std::size_t>& indices, std::int64_t not_before_ns) {
+  for (const std::size_t i : indices)
+    if (auto r = post(*workers_[i], Mail{MailKind::kOnHeld, Signal::kOn, 0}); !r) return r;
+  // Every task is on and waits; now one instant for all: each task's first release is its first
+  // grid point at or after it, published before any is let go (the same-rate rule reads it).
+  const std::int64_t instant = std::max(now_ns(), not_before_ns);
+  std::vector<std::pair<std::size_t, std::int64_t>> joins;
+  for (const std::size_t i : indices) {
+    Worker& w = *workers_[i];
+    if (!w.task->periodic() || w.task->state() != TaskState::kOn) continue;
+    const std::int64_t p = w.task->period_ns();
+    const std::int64_t k = (instant + p - 1) / p;
+    w.scheduled.store(k, std::memory_order_release);  // release: pairs with successors' acquire load
+    joins.emplace_back(i, k);
+  }
+  for (const auto& [i, k] : joins)
+    if (auto r = post(*workers_[i], Mail{MailKind::kJoin, Signal::kOn, k}); !r) return r;
+  return {};
+}
+
+void RealExecutive::variable_written(VarIndex v) {
+  for (auto& w : workers_) {
+    if (w->trigger_var.load(std::memory_order_relaxed) != static_cast<int>(v)) continue;  // a hint, see below
+    // acq_rel: the value written happens before the cycle that clears the flag
+    if (!w->update_pending.exchange(true, std::memory_order_acq_rel)) ring_bell(*w);
+  }
 }
 
 }  // namespace chimera

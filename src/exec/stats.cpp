@@ -45,6 +45,15 @@ std::int64_t LatencyHistogram::percentile(double fraction) const noexcept {
   return max();
 }
 
+std::vector<std::pair<std::int64_t, std::uint64_t>> LatencyHistogram::nonempty_buckets() const {
+  std::vector<std::pair<std::int64_t, std::uint64_t>> out;
+  for (int i = 0; i < kBuckets; ++i) {
+    const std::uint64_t n = buckets_[static_cast<std::size_t>(i)].load(std::memory_order_relaxed);  // untorn is enough
+    if (n != 0) out.emplace_back(upper_bound_of(i), n);
+  }
+  return out;
+}
+
 std::uint64_t LatencyHistogram::count() const noexcept { return count_.load(std::memory_order_relaxed); }
 std::int64_t LatencyHistogram::max() const noexcept { return max_.load(std::memory_order_relaxed); }
 
@@ -54,38 +63,62 @@ void LatencyHistogram::reset() noexcept {
   max_.store(0, std::memory_order_relaxed);
 }
 
-void TaskStats::record_cycle(std::int64_t latency_ns, std::int64_t exec_ns, bool missed) noexcept {
+namespace {
+// Single writer (the task's thread); relaxed: each figure is read on its own.
+void bump(std::atomic<std::uint64_t>& counter, std::uint64_t n = 1) noexcept {
+  counter.store(counter.load(std::memory_order_relaxed) + n, std::memory_order_relaxed);
+}
+}  // namespace
+
+void TaskStats::record_cycle(std::int64_t latency_ns, std::int64_t exec_ns, std::int64_t response_ns, bool missed,
+                             bool overrun) noexcept {
   latency_.record(latency_ns);
-  // Single writer (the task's thread); relaxed: each figure is read on its own.
-  cycles_.store(cycles_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
-  if (missed) missed_.store(missed_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+  exec_.record(exec_ns);
+  response_.record(response_ns);
+  bump(cycles_);
+  if (missed) bump(missed_);
+  if (overrun) bump(overruns_);
   exec_sum_ns_.store(exec_sum_ns_.load(std::memory_order_relaxed) + exec_ns, std::memory_order_relaxed);
   if (exec_ns > exec_max_ns_.load(std::memory_order_relaxed)) exec_max_ns_.store(exec_ns, std::memory_order_relaxed);
 }
 
-void TaskStats::record_order_timeout() noexcept {
-  // Single writer (the task's thread); relaxed: a counter read on its own.
-  order_timeouts_.store(order_timeouts_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+void TaskStats::record_skipped(std::uint64_t n) noexcept {
+  bump(skipped_, n);
+  bump(missed_, n);
 }
+
+void TaskStats::record_order_timeout() noexcept { bump(order_timeouts_); }
 
 TaskStatsSnapshot TaskStats::snapshot() const noexcept {
   TaskStatsSnapshot s;
   s.cycles = cycles_.load(std::memory_order_relaxed);  // figures may be one cycle apart: fine for a table
   s.missed = missed_.load(std::memory_order_relaxed);
+  s.overruns = overruns_.load(std::memory_order_relaxed);
+  s.skipped = skipped_.load(std::memory_order_relaxed);
   const std::int64_t sum = exec_sum_ns_.load(std::memory_order_relaxed);
   s.exec_mean_ns = s.cycles != 0 ? sum / static_cast<std::int64_t>(s.cycles) : 0;
+  s.exec_p50_ns = exec_.percentile(0.50);
+  s.exec_p99_ns = exec_.percentile(0.99);
   s.exec_max_ns = exec_max_ns_.load(std::memory_order_relaxed);
   s.latency_p50_ns = latency_.percentile(0.50);
   s.latency_p99_ns = latency_.percentile(0.99);
   s.latency_max_ns = latency_.max();
+  s.response_p99_ns = response_.percentile(0.99);
+  s.response_max_ns = response_.max();
+  s.exec_histogram = exec_.nonempty_buckets();
+  s.latency_histogram = latency_.nonempty_buckets();
   s.order_timeouts = order_timeouts_.load(std::memory_order_relaxed);
   return s;
 }
 
 void TaskStats::reset() noexcept {
   latency_.reset();
+  exec_.reset();
+  response_.reset();
   cycles_.store(0, std::memory_order_relaxed);  // only while the writer is idle
   missed_.store(0, std::memory_order_relaxed);
+  overruns_.store(0, std::memory_order_relaxed);
+  skipped_.store(0, std::memory_order_relaxed);
   order_timeouts_.store(0, std::memory_order_relaxed);
   exec_sum_ns_.store(0, std::memory_order_relaxed);
   exec_max_ns_.store(0, std::memory_order_relaxed);

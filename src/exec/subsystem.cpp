@@ -11,74 +11,19 @@
 #include <fmt/format.h>
 
 #include "chimera/exec/clock.hpp"
-#include "chimera/exec/task.hpp"
-#include "real_executive.hpp"
-#include "release_order.hpp"
+#include "futex.hpp"
+#include "subsystem_impl.hpp"
 #include "value_codec.hpp"
-#include "virtual_executive.hpp"
 
 namespace chimera {
 
 namespace {
-class TableFlags final : public SubsystemFlags {
- public:
-  explicit TableFlags(const GlobalTable* table) : table_(table) {}
-  [[nodiscard]] bool illegal_configuration() const noexcept override { return table_->illegal_configuration(); }
-
- private:
-  const GlobalTable* table_;
-};
-
 std::string join_lines(const std::vector<Violation>& violations) {
   std::string out;
   for (const auto& v : violations) out += (out.empty() ? "" : "\n") + v.message;
   return out;
 }
 }  // namespace
-
-struct Subsystem::Impl {
-  SubsystemSpec spec;
-  RunOptions options;
-  Resolution resolution;
-  std::string configuration;
-  std::unique_ptr<GlobalTable> table;
-  std::unique_ptr<TableFlags> flags;
-  std::vector<std::unique_ptr<Task>> tasks;
-  ReleaseOrder order;
-  std::unique_ptr<VirtualExecutive> virtual_exec;
-  std::unique_ptr<RealExecutive> real_exec;
-  std::vector<std::string> last_error;
-  std::vector<Event> pending;  // collected from the tasks' rings, not yet handed to a caller
-  std::mutex events_mutex;     // guards pending and last_error; never taken by a task's thread
-  std::int64_t stopped_at_ns = 0;
-  bool stopped = false;
-
-  /// Moves every task's real-time events into `pending` and notes the last failure of each.
-  void collect_events() {
-    std::lock_guard<std::mutex> lock(events_mutex);
-    RtEvent e;
-    for (std::size_t i = 0; i < tasks.size(); ++i) {
-      while (tasks[i]->events().pop(e)) {
-        pending.push_back(Event{e.time_ns, tasks[i]->name(), e.text.data()});
-        if (std::strstr(e.text.data(), "ERROR") != nullptr || std::strstr(e.text.data(), "failed") != nullptr)
-          last_error[i] = e.text.data();
-      }
-    }
-  }
-
-  [[nodiscard]] std::int64_t now() const {
-    if (stopped) return stopped_at_ns;
-    return virtual_exec ? virtual_exec->now_ns() : real_exec->now_ns();
-  }
-  Result<void> signal(std::size_t i, Signal s) const {  // const: the executives are owned, not members' state
-    return virtual_exec ? virtual_exec->signal(i, s) : real_exec->signal(i, s);
-  }
-  std::optional<std::size_t> index_of(std::string_view name) const {
-    for (std::size_t i = 0; i < tasks.size(); ++i)
-      if (tasks[i]->name() == name) return i;
-    return std::nullopt;
-  }
-};
 
 Subsystem::Subsystem() : impl_(std::make_unique<Impl>()) {}
 Subsystem::~Subsystem() { stop(); }
@@ -108,7 +53,7 @@ Result<std::unique_ptr<Subsystem>> Subsystem::create(const SubsystemSpec& spec, 
   auto table = GlobalTable::create(m.spec.name + m.options.shm_suffix, m.resolution.subsystem.variables);
   if (!table) return table.error();
   m.table = std::make_unique<GlobalTable>(std::move(*table));
-  m.flags = std::make_unique<TableFlags>(m.table.get());
+  m.flags = std::make_unique<detail::TableFlags>(m.table.get());
   // Constants known up front (the file's and the out-consts modules declare) are in the table
   // before any init, so that an in-const reads its value whatever order tasks are spawned in.
   for (const auto& [name, values] : m.resolution.subsystem.constant_values) {
@@ -118,24 +63,36 @@ Result<std::unique_ptr<Subsystem>> Subsystem::create(const SubsystemSpec& spec, 
     }
   }
 
+  std::vector<std::string> configuration_names;
+  for (const auto& c : m.spec.configurations) configuration_names.push_back(c.name);
+  m.requests = std::make_unique<SubsystemRequestBoard>(configuration_names, m.resolution.subsystem.tasks.size());
+  m.served.assign(m.resolution.subsystem.tasks.size(), -1);
   std::vector<Task*> raw;
   for (const auto& rt : m.resolution.subsystem.tasks) {
     m.tasks.push_back(std::make_unique<Task>(rt, *m.table, *m.flags));
+    m.tasks.back()->set_request_board(m.requests.get(), static_cast<int>(raw.size()));
     raw.push_back(m.tasks.back().get());
   }
   m.last_error.assign(m.tasks.size(), {});
   m.order = compute_release_order(m.resolution.subsystem);
+  const ConfigurationSpec* start_config = m.spec.find_configuration(m.configuration);
+  m.plan = make_schedule_plan(m.resolution.subsystem, m.order, subsystem_cpus(m.spec), start_config->tasks);
+  for (Task* t : raw) {
+    t->set_virtual_clock(m.options.clock == ClockKind::kVirtual);
+    if (m.options.measure_cpu_time || t->spec().wcet_ns) t->set_exec_clock(Task::ExecClock::kCpu);
+  }
   if (m.options.clock == ClockKind::kVirtual) {
-    m.virtual_exec = std::make_unique<VirtualExecutive>(raw, m.order);
+    m.virtual_exec = std::make_unique<VirtualExecutive>(raw, m.order, m.plan, *m.table);
   } else {
     prepare_realtime_process(m.options.realtime_priorities);
-    m.real_exec = std::make_unique<RealExecutive>(raw, m.order, m.spec, m.options.realtime_priorities);
+    m.real_exec = std::make_unique<RealExecutive>(raw, m.order, m.plan, m.options.realtime_priorities, *m.table);
   }
   return s;
 }
 
 Result<void> Subsystem::start() {
   Impl& m = *impl_;
+  std::lock_guard<std::mutex> lock(m.ops_mutex);
   const ConfigurationSpec* config = m.spec.find_configuration(m.configuration);
   std::vector<std::size_t> members;
   for (const auto& name : config->tasks) members.push_back(*m.index_of(name));
@@ -146,18 +103,39 @@ Result<void> Subsystem::start() {
   };
   for (const std::size_t i : members)
     if (auto r = m.signal(i, Signal::kSpawn); !r) return abandon(r.error());
-  for (const std::size_t i : members)
-    if (auto r = m.signal(i, Signal::kOn); !r) return abandon(r.error());
+  // On together: no task runs a release before the others are on (the virtual clock does not
+  // move while they turn on, so there one after the other is together).
+  if (m.real_exec) {
+    if (auto r = m.real_exec->turn_on_together(members); !r) return abandon(r.error());
+  } else {
+    for (const std::size_t i : members)
+      if (auto r = m.signal(i, Signal::kOn); !r) return abandon(r.error());
+  }
+  m.collect_events();
+  // Real clock: a thread of the subsystem interface carries out the switches tasks ask for (the
+  // virtual clock does it in run_for, at the very instant they are asked for).
+  if (m.real_exec && !m.request_service.joinable())
+    m.request_service = std::thread([this] {
+      Impl& self = *impl_;
+      for (;;) {
+        const std::uint32_t seen = self.requests->changes().load(std::memory_order_acquire);  // acquire: the requests
+        if (self.service_stop.load(std::memory_order_acquire)) return;  // acquire: pairs with stop()
+        serve_requests();
+        (void)detail::futex_wait(self.requests->changes(), seen, -1);
+      }
+    });
   return {};
 }
 
 Result<void> Subsystem::signal(std::string_view task, Signal signal) {
   Impl& m = *impl_;
+  std::lock_guard<std::mutex> lock(m.ops_mutex);
   if (m.stopped) return make_error(Errc::kState, "the subsystem is stopped");
   const auto i = m.index_of(task);
   if (!i) return make_error(Errc::kNotFound, fmt::format("no task named '{}'", task));
   auto r = m.signal(*i, signal);
   m.collect_events();
+  m.update_flag();  // a task cleared or killed out of ERROR may lower the flag
   return r;
 }
 
@@ -165,7 +143,10 @@ void Subsystem::run_for(std::int64_t ns) {
   Impl& m = *impl_;
   if (ns <= 0 || m.stopped) return;
   if (m.virtual_exec) {
-    m.virtual_exec->run_until(m.virtual_exec->now_ns() + ns);
+    const std::int64_t end = m.virtual_exec->now_ns() + ns;
+    // A task that asks for a switch stops the simulation at that instant; the switch happens
+    // there, and the run goes on: the same file and inputs give the same trace.
+    while (!m.virtual_exec->run_until(end, &m.requests->changes())) serve_requests();
   } else {
     std::this_thread::sleep_for(std::chrono::nanoseconds(ns));
   }
@@ -173,6 +154,12 @@ void Subsystem::run_for(std::int64_t ns) {
 
 void Subsystem::stop() {
   Impl& m = *impl_;
+  if (m.request_service.joinable()) {
+    m.service_stop.store(true, std::memory_order_release);  // release: the service sees it after its wake
+    m.requests->wake();
+    m.request_service.join();
+  }
+  std::lock_guard<std::mutex> lock(m.ops_mutex);
   if (m.stopped || !m.table) return;
   // The paper's two-step termination: every task off, then every task killed.
   for (std::size_t i = 0; i < m.tasks.size(); ++i)
@@ -210,6 +197,7 @@ Result<std::vector<double>> Subsystem::get(std::string_view variable) const {
 
 Result<void> Subsystem::set(std::string_view variable, const std::vector<double>& values) {
   Impl& m = *impl_;
+  std::lock_guard<std::mutex> lock(m.ops_mutex);  // no switch may turn a producer on meanwhile
   if (m.stopped) return make_error(Errc::kState, "the subsystem is stopped");
   const auto v = m.table->find(variable);
   if (!v) return make_error(Errc::kNotFound, fmt::format("no state variable named '{}'", variable));
@@ -224,18 +212,20 @@ Result<void> Subsystem::set(std::string_view variable, const std::vector<double>
   auto bytes = encode_values(m.table->shape(*v), values);
   if (!bytes) return bytes.error();
   m.table->write(*v, bytes->data());
+  if (m.real_exec) m.real_exec->variable_written(*v);  // the virtual clock sees the new version itself
   return {};
 }
 
 std::vector<TaskSnapshot> Subsystem::snapshot() const {
   Impl& m = *impl_;
-  m.collect_events();  // so that last_error is current whether or not anyone drains events
+  std::lock_guard<std::mutex> ops(m.ops_mutex);  // the plan changes at a switch
+  m.collect_events();                            // so that last_error is current whether or not anyone drains events
   std::lock_guard<std::mutex> lock(m.events_mutex);
   std::vector<TaskSnapshot> out;
   for (std::size_t i = 0; i < m.tasks.size(); ++i) {
     const Task& t = *m.tasks[i];
-    out.push_back(TaskSnapshot{t.name(), t.spec().module, t.state(), t.period_ns(), t.spec().cpu.value_or(-1),
-                               t.stats().snapshot(), m.last_error[i]});
+    out.push_back(TaskSnapshot{t.name(), t.spec().module, t.state(), t.period_ns(), m.plan.cpu[i], t.stats().snapshot(),
+                               m.last_error[i]});
   }
   return out;
 }

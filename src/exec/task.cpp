@@ -1,7 +1,11 @@
 #include "chimera/exec/task.hpp"
 
 #include <array>
+#include <bit>
+#include <charconv>
+#include <ctime>
 #include <exception>
+#include <limits>
 
 #include <fmt/format.h>
 
@@ -24,11 +28,6 @@ Task::Task(const ResolvedTask& resolved, GlobalTable& table, const SubsystemFlag
 
 Task::~Task() {
   if (state() != TaskState::kNotCreated) (void)apply(Signal::kKill, timing_.release_ns);
-}
-
-void Task::set_state(TaskState s) noexcept {
-  state_.store(s, std::memory_order_release);  // release: what the method did is visible to whoever sees the state
-  if (s == TaskState::kError) ever_in_error_.store(true, std::memory_order_relaxed);  // a latch, read on its own
 }
 
 Status Task::call_raw(Hook hook) noexcept {
@@ -64,7 +63,9 @@ Status Task::call(Hook hook) noexcept {
 
 bool Task::recover(Hook hook, Status failure, std::int64_t now_ns) noexcept {
   events_.push(now_ns, hook_name(static_cast<std::uint8_t>(hook)), " failed: ", failure.reason());
+  timing_.fault = Fault::kMethodFailed;
   const Status handled = call(Hook::kError);
+  timing_.fault = Fault::kNone;
   if (handled.is_ok()) {
     events_.push(now_ns, "error() recovered", nullptr);
     return true;
@@ -74,19 +75,113 @@ bool Task::recover(Hook hook, Status failure, std::int64_t now_ns) noexcept {
   return false;
 }
 
-void Task::run_cycle(std::int64_t release_ns, std::int64_t start_ns, std::int64_t deadline_ns,
-                     bool clock_is_virtual) noexcept {
-  if (state() != TaskState::kOn) return;
+std::int64_t Task::exec_clock_now() const noexcept {
+  if (exec_clock_ == ExecClock::kWall) return monotonic_ns();
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+std::int64_t Task::absolute_deadline(std::int64_t release_ns) const noexcept {
+  if (spec_.deadline_ns <= 0) return std::numeric_limits<std::int64_t>::max();
+  return release_ns + spec_.deadline_ns;
+}
+
+std::int64_t Task::begin_job(std::int64_t release_ns, std::int64_t start_ns) noexcept {
+  if (state() != TaskState::kOn) return -1;
   timing_.release_ns = release_ns;
-  const std::int64_t exec_start = monotonic_ns();
-  const Status s = call(Hook::kCycle);
-  const std::int64_t exec_ns = monotonic_ns() - exec_start;
-  if (!s.is_ok()) (void)recover(Hook::kCycle, s, start_ns);
-  // On the virtual clock a cycle takes no simulated time, so only a late start can miss.
-  const std::int64_t end_ns = clock_is_virtual ? start_ns : start_ns + exec_ns;
-  const bool missed = end_ns > release_ns + deadline_ns;
-  stats_.record_cycle(start_ns - release_ns, exec_ns, missed);
+  timing_.start_ns = start_ns;
+  job_ = Job{true, false, release_ns, start_ns, exec_clock_now()};
+  module_->virtual_ns_ = 0;
+  local_->pull_in_vars();
+  // An aperiodic task first takes its event from the resource port, then processes it.
+  Hook hook = Hook::kSync;
+  Status s = trigger_.any() ? call_raw(Hook::kSync) : Status::ok();
+  if (s.is_ok()) {
+    hook = Hook::kCycle;
+    s = call_raw(Hook::kCycle);
+  }
+  if (!s.is_ok()) {
+    local_->push_out_vars();  // what the failed method wrote is published, as after any method
+    job_.failed = true;
+    (void)recover(hook, s, start_ns);
+  }
+  return spec_.virtual_exec_ns + module_->virtual_ns_;
+}
+
+std::int64_t Task::end_job(std::int64_t end_ns, std::int64_t used_ns) noexcept {
+  if (!job_.open) return 0;
+  job_.open = false;
+  if (!job_.failed && local_) local_->push_out_vars();
+  const std::int64_t exec_ns = exec_clock_now() - job_.exec_start;
+  if (used_ns < 0) used_ns = exec_ns;
+  const bool missed = end_ns > absolute_deadline(job_.release_ns);
+  const bool overrun = spec_.wcet_ns.has_value() && used_ns > *spec_.wcet_ns;
+  stats_.record_cycle(job_.start_ns - job_.release_ns, exec_ns, end_ns - job_.release_ns, missed, overrun);
   ++timing_.cycle;
+  if ((missed || overrun) && hard() && state() == TaskState::kOn)
+    timing_fault(missed ? Fault::kDeadlineMissed : Fault::kBudgetOverrun, end_ns);
+  return used_ns;
+}
+
+bool Task::reads_const(std::string_view name) const {
+  for (const auto& b : resolved_.bindings)
+    if (b.kind == PortKind::kInConst && b.variable == name) return true;
+  return false;
+}
+
+std::vector<std::string> Task::const_outputs() const {
+  std::vector<std::string> out;
+  for (const auto& b : resolved_.bindings)
+    if (b.kind == PortKind::kOutConst) out.push_back(b.variable);
+  return out;
+}
+
+bool Task::reinit(std::int64_t now_ns) noexcept {
+  if (state() != TaskState::kOn) return false;
+  local_->pull_in_consts();
+  reinits_.fetch_add(1, std::memory_order_relaxed);  // a counter read on its own
+  const Status s = call(Hook::kReinit);
+  if (!s.is_ok() && !recover(Hook::kReinit, s, now_ns)) return false;
+  return state() == TaskState::kOn;
+}
+
+void Task::skip_releases(std::uint64_t n, std::int64_t now_ns) noexcept {
+  if (n == 0) return;
+  stats_.record_skipped(n);
+  if (hard() && state() == TaskState::kOn) timing_fault(Fault::kDeadlineMissed, now_ns);
+}
+
+void Task::timing_fault(Fault fault, std::int64_t now_ns) noexcept {
+  const char* what = fault == Fault::kDeadlineMissed ? "missed its deadline" : "overran its wcet budget";
+  ++timing_faults_;
+  timing_.fault = fault;
+  const Status handled = call(Hook::kError);
+  timing_.fault = Fault::kNone;
+  if (handled.is_ok()) {
+    // A recovered timing fault can repeat every cycle: tell the operator at 1, 2, 4, 8... so the
+    // ring never floods while the count stays visible in the timing table.
+    if (std::has_single_bit(timing_faults_)) {
+      std::array<char, 24> count{};
+      const auto [end, ec] = std::to_chars(count.data(), count.data() + count.size() - 1, timing_faults_);
+      *end = '\0';
+      (void)ec;  // 24 characters hold any 64-bit count
+      events_.push(now_ns, what, "; error() recovered; timing faults so far: ", count.data());
+    }
+    return;
+  }
+  set_state(TaskState::kError);
+  events_.push(now_ns, "ERROR: operator intervention required (clear): ", what);
+}
+
+void Task::set_state(TaskState s) noexcept {
+  state_.store(s, std::memory_order_release);  // release: what the method did is visible to whoever sees the state
+  if (s == TaskState::kError) {
+    ever_in_error_.store(true, std::memory_order_relaxed);  // a latch, read on its own
+    // The paper's flag also marks an error in the subsystem, so that critical modules keep the
+    // system safe; the subsystem interface lowers it once no task is in ERROR.
+    table_.set_illegal_configuration(true);
+  }
 }
 
 Result<void> Task::apply(Signal signal, std::int64_t now_ns) {
@@ -109,9 +204,11 @@ Result<void> Task::spawn(std::int64_t now_ns) {
   if (!local) return make_error(Errc::kModuleFault, fmt::format("{}: {}", spec_.name, local.error().message));
   local_ = std::make_unique<LocalTable>(std::move(*local));
   module_ = resolved_.module->make();
-  timing_ = CycleTiming{now_ns, spec_.period_ns.value_or(0), 0};
+  timing_ = CycleTiming{now_ns, now_ns, spec_.period_ns.value_or(0), 0, virtual_clock_, Fault::kNone};
+  trigger_ = Trigger{};
+  job_ = Job{};
 
-  InitContext ctx(spec_.name, spec_.params, *local_, timing_, flags_);
+  InitContext ctx(spec_.name, spec_.params, *local_, timing_, flags_, trigger_, services_);
   local_->pull_in_consts();
   local_->pull_in_vars();
   Status s = Status::ok();
@@ -134,6 +231,8 @@ Result<void> Task::spawn(std::int64_t now_ns) {
   }
   local_->push_out_consts();
   local_->push_out_vars();
+  if (!periodic() && !trigger_.any())
+    events_.push(now_ns, "aperiodic, and its module declared no trigger in init: it will never cycle", nullptr);
   set_state(TaskState::kOff);
   return {};
 }
@@ -145,6 +244,9 @@ Result<void> Task::turn_on(std::int64_t now_ns) {
   timing_.release_ns = now_ns;
   const Status s = call(Hook::kOn);
   if (s.is_ok()) {
+    // Its out-consts are the subsystem's again: another producer of one of them may have
+    // published a different value while this task was off (a switch back).
+    local_->push_out_consts();
     set_state(TaskState::kOn);
     return {};
   }

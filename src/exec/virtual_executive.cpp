@@ -1,55 +1,265 @@
 #include "virtual_executive.hpp"
 
+#include <poll.h>
+
 #include <algorithm>
 #include <limits>
-#include <numeric>
+
+#include "chimera/svt/global_table.hpp"
 
 namespace chimera {
 
-VirtualExecutive::VirtualExecutive(std::vector<Task*> tasks, const ReleaseOrder& order)
-    : tasks_(std::move(tasks)), next_release_(tasks_.size(), -1), dispatch_order_(tasks_.size()) {
-  std::iota(dispatch_order_.begin(), dispatch_order_.end(), std::size_t{0});
-  // Rate-monotonic priority first (shorter period runs first at a shared instant), then the
-  // data-flow rule, then the file: the same order the real executive's priorities and
-  // precedence waits produce.
-  std::stable_sort(dispatch_order_.begin(), dispatch_order_.end(), [&](std::size_t a, std::size_t b) {
-    const auto pa = tasks_[a]->period_ns();
-    const auto pb = tasks_[b]->period_ns();
-    if (pa != pb) return pa < pb;
-    return order.rank[a] < order.rank[b];
-  });
+namespace {
+constexpr std::int64_t kNever = std::numeric_limits<std::int64_t>::max();
+}  // namespace
+
+VirtualExecutive::VirtualExecutive(std::vector<Task*> tasks, const ReleaseOrder& order, SchedulePlan plan,
+                                   const GlobalTable& table)
+    : tasks_(std::move(tasks)), order_(order), plan_(std::move(plan)), table_(table), slots_(tasks_.size()) {
+  std::vector<int> cpus;
+  for (const int c : plan_.cpu)
+    if (std::find(cpus.begin(), cpus.end(), c) == cpus.end()) cpus.push_back(c);
+  running_.assign(cpus.size(), -1);
+  for (const int c : plan_.cpu)
+    cpu_slot_.push_back(static_cast<int>(std::find(cpus.begin(), cpus.end(), c) - cpus.begin()));
+  for (auto& s : slots_) s.server.refills.reserve(kMaxRefills);
+}
+
+JobUrgency VirtualExecutive::urgency_of(std::size_t i) const {
+  const std::int64_t r = slots_[i].job.release_ns;
+  return JobUrgency{r, tasks_[i]->absolute_deadline(r)};
+}
+
+bool VirtualExecutive::blocked_by_producer(std::size_t i) const {
+  // The same-rate data-flow rule: a job waits for its same-period producers' job of the same
+  // release, as the real executive's precedence wait does, and no longer than that wait's bound.
+  const Slot& s = slots_[i];
+  if (now_ns_ >= s.job.wait_until_ns) return false;
+  for (const int p : order_.predecessors[i]) {
+    const Slot& ps = slots_[static_cast<std::size_t>(p)];
+    if (tasks_[static_cast<std::size_t>(p)]->state() != TaskState::kOn) continue;
+    if (ps.first_release_ns > s.job.release_ns) continue;  // it joined after this release
+    if (ps.last_done_release_ns < s.job.release_ns) return true;
+  }
+  return false;
+}
+
+bool VirtualExecutive::ready(std::size_t i) const {
+  const Slot& s = slots_[i];
+  if (!s.job.active) return false;
+  if (s.job.started) return true;
+  return !blocked_by_producer(i);
+}
+
+void VirtualExecutive::release_periodic(std::size_t i) {
+  Task& t = *tasks_[i];
+  Slot& s = slots_[i];
+  if (s.next_release_ns < 0 || s.job.active || s.next_release_ns > now_ns_) return;
+  const std::int64_t period = t.period_ns();
+  if (t.spec().late == LatePolicy::kSkip) {
+    // Releases whose deadline has already passed are not worth starting: skip them.
+    std::uint64_t skipped = 0;
+    while (s.next_release_ns <= now_ns_ && t.absolute_deadline(s.next_release_ns) < now_ns_) {
+      s.next_release_ns += period;
+      ++skipped;
+    }
+    t.skip_releases(skipped, now_ns_);
+    if (t.state() != TaskState::kOn) {
+      s.next_release_ns = -1;
+      return;
+    }
+    if (s.next_release_ns > now_ns_) return;
+  }
+  s.job = Job{true, false, s.next_release_ns, 0, 0, s.next_release_ns + t.spec().deadline_ns / 2};
+  s.next_release_ns += period;
+}
+
+void VirtualExecutive::poll_triggers() {
+  for (std::size_t i = 0; i < tasks_.size(); ++i) {
+    Task& t = *tasks_[i];
+    Slot& s = slots_[i];
+    if (t.periodic() || t.state() != TaskState::kOn) continue;
+    if (s.trigger_var >= 0) {
+      const std::uint64_t v = table_.version(static_cast<VarIndex>(s.trigger_var));
+      if (v != s.seen_version) {
+        s.seen_version = v;
+        ++s.events;  // several writes at one instant are one event: the latest value is what counts
+      }
+    }
+    if (t.trigger().fd >= 0 && s.events == 0 && !s.job.active && now_ns_ >= s.next_fd_poll_ns) {
+      pollfd p{t.trigger().fd, POLLIN, 0};
+      if (::poll(&p, 1, 0) > 0 && (p.revents & (POLLIN | POLLERR | POLLHUP)) != 0)
+        s.events = 1;
+      else
+        s.next_fd_poll_ns = now_ns_ + kPollPeriodNs;
+    }
+    const bool background = plan_.urgency[i].background;
+    if (s.events > 0 && !s.job.active && (background || s.server.budget_ns > 0)) {
+      --s.events;
+      s.job = Job{true, false, now_ns_, 0, 0, now_ns_};
+    }
+  }
+}
+
+void VirtualExecutive::refill_servers() {
+  for (auto& s : slots_) {
+    auto& r = s.server.refills;
+    std::size_t done = 0;
+    while (done < r.size() && r[done].first <= now_ns_) s.server.budget_ns += r[done++].second;
+    r.erase(r.begin(), r.begin() + static_cast<std::ptrdiff_t>(done));  // no allocation: erasing only
+  }
+}
+
+void VirtualExecutive::finish(std::size_t i) {
+  Task& t = *tasks_[i];
+  Slot& s = slots_[i];
+  t.end_job(now_ns_, s.job.exec_ns);
+  s.last_done_release_ns = s.job.release_ns;
+  if (t.spec().server) {
+    // Sporadic server: what a job used comes back one server period after the job started.
+    auto& r = s.server.refills;
+    const std::int64_t at = s.job_start_ns + t.spec().server->period_ns;
+    if (r.size() < kMaxRefills)
+      r.emplace_back(at, s.job.exec_ns);
+    else
+      r.back() = {std::max(r.back().first, at), r.back().second + s.job.exec_ns};  // merged, later: safe
+    s.server.budget_ns -= s.job.exec_ns;
+  }
+  s.job = Job{};
+  s.next_fd_poll_ns = now_ns_;  // level-triggered: look again right away
+  const int c = cpu_slot_[i];
+  if (running_[static_cast<std::size_t>(c)] == static_cast<int>(i)) running_[static_cast<std::size_t>(c)] = -1;
+  if (t.periodic() && t.state() != TaskState::kOn) s.next_release_ns = -1;
+}
+
+void VirtualExecutive::dispatch() {
+  for (;;) {
+    // The most urgent ready job of each CPU, and among the CPUs whose choice changes, the most
+    // urgent of all first: a job of no simulated time ends at once and may unblock others.
+    int pick = -1;
+    for (std::size_t c = 0; c < running_.size(); ++c) {
+      int best = -1;
+      for (std::size_t i = 0; i < tasks_.size(); ++i) {
+        if (cpu_slot_[i] != static_cast<int>(c) || !ready(i)) continue;
+        if (best < 0 ||
+            more_urgent(plan_.policy, plan_.urgency[i], urgency_of(i), plan_.urgency[static_cast<std::size_t>(best)],
+                        urgency_of(static_cast<std::size_t>(best))))
+          best = static_cast<int>(i);
+      }
+      if (best < 0 || best == running_[c]) continue;
+      const auto b = static_cast<std::size_t>(best);
+      if (pick < 0 ||
+          more_urgent(plan_.policy, plan_.urgency[b], urgency_of(b), plan_.urgency[static_cast<std::size_t>(pick)],
+                      urgency_of(static_cast<std::size_t>(pick))))
+        pick = best;
+    }
+    if (pick < 0) return;
+    const auto i = static_cast<std::size_t>(pick);
+    Slot& s = slots_[i];
+    running_[static_cast<std::size_t>(cpu_slot_[i])] = pick;  // preempts whatever ran there
+    if (!s.job.started) {
+      s.job.started = true;
+      s.job_start_ns = now_ns_;
+      const std::int64_t cost = tasks_[i]->begin_job(s.job.release_ns, now_ns_);
+      s.job.exec_ns = std::max<std::int64_t>(cost, 0);
+      s.job.remaining_ns = tasks_[i]->state() == TaskState::kOn ? s.job.exec_ns : 0;
+    }
+    if (s.job.remaining_ns <= 0) {
+      finish(i);
+      poll_triggers();  // what it published may wake an aperiodic task at this same instant
+    }
+  }
+}
+
+std::int64_t VirtualExecutive::next_event_after_dispatch() const {
+  std::int64_t t = kNever;
+  for (std::size_t i = 0; i < tasks_.size(); ++i) {
+    const Slot& s = slots_[i];
+    const Task& task = *tasks_[i];
+    if (!s.job.active && s.next_release_ns >= 0) t = std::min(t, s.next_release_ns);
+    if (s.job.active && !s.job.started && s.job.wait_until_ns > now_ns_) t = std::min(t, s.job.wait_until_ns);
+    if (!s.server.refills.empty()) t = std::min(t, s.server.refills.front().first);
+    const bool watching = !task.periodic() && task.state() == TaskState::kOn && task.trigger().fd >= 0;
+    if (watching && !s.job.active && s.events == 0) t = std::min(t, std::max(s.next_fd_poll_ns, now_ns_ + 1));
+  }
+  for (const int r : running_)
+    if (r >= 0) t = std::min(t, now_ns_ + slots_[static_cast<std::size_t>(r)].job.remaining_ns);
+  return t;
+}
+
+void VirtualExecutive::advance_to(std::int64_t t) {
+  const std::int64_t dt = t - now_ns_;
+  for (const int r : running_)
+    if (r >= 0) slots_[static_cast<std::size_t>(r)].job.remaining_ns -= dt;
+  now_ns_ = t;
+}
+
+void VirtualExecutive::step() {
+  refill_servers();
+  for (const int r : running_)
+    if (r >= 0 && slots_[static_cast<std::size_t>(r)].job.remaining_ns <= 0) finish(static_cast<std::size_t>(r));
+  for (std::size_t i = 0; i < tasks_.size(); ++i)
+    if (tasks_[i]->periodic()) release_periodic(i);
+  poll_triggers();
+  dispatch();
+}
+
+bool VirtualExecutive::run_until(std::int64_t end_ns, const std::atomic<std::uint32_t>* watch) {
+  const std::uint32_t seen = watch != nullptr ? watch->load(std::memory_order_acquire) : 0;  // acquire: the request
+  for (;;) {
+    step();
+    if (watch != nullptr && watch->load(std::memory_order_acquire) != seen) return false;  // acquire: as above
+    const std::int64_t t = next_event_after_dispatch();
+    if (t >= end_ns) break;
+    advance_to(t);
+  }
+  if (end_ns > now_ns_) advance_to(end_ns);
+  return true;
+}
+
+Result<void> VirtualExecutive::reinit(std::size_t task) {
+  if (tasks_[task]->reinit(now_ns_)) return {};
+  return make_error(Errc::kModuleFault, tasks_[task]->name() + ": reinit failed; the task is no longer ON");
+}
+
+void VirtualExecutive::end_open_job(std::size_t i) {
+  Slot& s = slots_[i];
+  if (!s.job.active) return;
+  if (s.job.started)
+    finish(i);  // a signal is handled between cycles: the job ends now
+  else
+    s.job = Job{};  // released but not started: it never runs
 }
 
 Result<void> VirtualExecutive::signal(std::size_t task, Signal signal) {
   Task& t = *tasks_[task];
+  Slot& s = slots_[task];
+  end_open_job(task);
   auto r = t.apply(signal, now_ns_);
-  if (t.state() == TaskState::kOn && t.periodic()) {
-    if (next_release_[task] < 0) {
-      const std::int64_t p = t.period_ns();
-      next_release_[task] = (now_ns_ + p - 1) / p * p;  // the first whole multiple of the period from now
+  if (t.state() != TaskState::kOn) {
+    s.next_release_ns = -1;
+    s.events = 0;
+    return r;
+  }
+  if (t.periodic() && s.next_release_ns < 0) {
+    const std::int64_t p = t.period_ns();
+    s.next_release_ns = (now_ns_ + p - 1) / p * p;  // the first whole multiple of the period from now
+    s.first_release_ns = s.next_release_ns;
+    s.last_done_release_ns = -1;
+  }
+  if (!t.periodic()) {
+    s.trigger_var = -1;
+    if (!t.trigger().update_port.empty()) {
+      for (const auto& b : t.resolved().bindings)
+        if (b.port == t.trigger().update_port)
+          if (auto v = table_.find(b.variable)) s.trigger_var = static_cast<int>(*v);
+      if (s.trigger_var >= 0) s.seen_version = table_.version(static_cast<VarIndex>(s.trigger_var));
     }
-  } else {
-    next_release_[task] = -1;
+    if (t.spec().server && s.server.refills.empty() && s.server.budget_ns <= 0)
+      s.server.budget_ns = t.spec().server->budget_ns;
+    s.next_fd_poll_ns = now_ns_;
   }
   return r;
-}
-
-void VirtualExecutive::run_until(std::int64_t end_ns) {
-  for (;;) {
-    std::int64_t instant = std::numeric_limits<std::int64_t>::max();
-    for (std::size_t i = 0; i < tasks_.size(); ++i)
-      if (next_release_[i] >= 0) instant = std::min(instant, next_release_[i]);
-    if (instant >= end_ns) break;
-    now_ns_ = instant;
-    for (const std::size_t i : dispatch_order_) {
-      if (next_release_[i] != instant) continue;
-      Task& t = *tasks_[i];
-      t.run_cycle(instant, instant, t.spec().deadline_ns, /*clock_is_virtual=*/true);
-      // A task that failed into ERROR stops being released; an ON one is released again.
-      next_release_[i] = t.state() == TaskState::kOn ? instant + t.period_ns() : -1;
-    }
-  }
-  now_ns_ = std::max(now_ns_, end_ns);
 }
 
 }  // namespace chimera

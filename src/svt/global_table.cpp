@@ -240,6 +240,7 @@ Result<GlobalTable> GlobalTable::create(std::string_view subsystem_name, std::sp
   }
   // Release: a process that attaches and sees the magic (acquire) sees the whole layout above.
   Word(header->magic).store(svt_detail::kMagic, std::memory_order_release);
+  table.locate_blocks();
   return table;
 }
 
@@ -283,12 +284,14 @@ Result<GlobalTable> GlobalTable::attach(std::string_view subsystem_name) {
                                                  shm, header->layout_version, svt_detail::kLayoutVersion));
   }
   if (auto r = check_layout(table.base_, size, shm); !r) return r.error();
+  table.locate_blocks();
   return table;
 }
 
 GlobalTable::GlobalTable(GlobalTable&& other) noexcept
     : shm_name_(std::move(other.shm_name_)),
       base_(std::exchange(other.base_, nullptr)),
+      blocks_(std::move(other.blocks_)),
       mapped_bytes_(std::exchange(other.mapped_bytes_, 0)),
       owner_(std::exchange(other.owner_, false)) {}
 
@@ -297,6 +300,7 @@ GlobalTable& GlobalTable::operator=(GlobalTable&& other) noexcept {
     release();
     shm_name_ = std::move(other.shm_name_);
     base_ = std::exchange(other.base_, nullptr);
+    blocks_ = std::move(other.blocks_);
     mapped_bytes_ = std::exchange(other.mapped_bytes_, 0);
     owner_ = std::exchange(other.owner_, false);
   }
@@ -316,8 +320,16 @@ void GlobalTable::release() noexcept {
   ::munmap(base_, mapped_bytes_);
   if (owner_ && creator_here) ::shm_unlink(shm_name_.c_str());
   base_ = nullptr;
+  blocks_.clear();
   mapped_bytes_ = 0;
   owner_ = false;
+}
+
+void GlobalTable::locate_blocks() {
+  const auto* header = object_at<Header>(base_, 0);
+  blocks_.clear();
+  blocks_.reserve(header->var_count);
+  for (VarIndex v = 0; v < header->var_count; ++v) blocks_.push_back(svt_detail::block_ref(base_, v));
 }
 
 std::size_t GlobalTable::size() const noexcept { return mapped_bytes_; }

@@ -1,5 +1,5 @@
 // GlobalTable's writes, reads and flag: the protocol of svt/seq_protocol.hpp applied to one
-// variable's block, located through the directory once per call.
+// variable's block, located through the directory once per table (blocks_).
 
 #include <array>
 #include <atomic>
@@ -19,33 +19,9 @@ namespace d = svt_detail;
 constexpr std::size_t kSmallScratchWords = 64;
 constexpr std::size_t kLargeScratchWords = 1024;
 
-}  // namespace
-
-void GlobalTable::begin_write(VarIndex v) noexcept {
-  const d::BlockRef b = d::block_ref(base_, v);
-  d::write_begin(b, d::next_write(b));
-}
-
-void GlobalTable::store_bytes(VarIndex v, std::size_t byte_offset, const void* src, std::size_t bytes) noexcept {
-  const d::BlockRef b = d::block_ref(base_, v);
-  d::write_bytes(b, d::next_write(b), byte_offset, static_cast<const std::byte*>(src), bytes);
-}
-
-void GlobalTable::end_write(VarIndex v) noexcept {
-  const d::BlockRef b = d::block_ref(base_, v);
-  d::write_end(b, d::next_write(b));
-}
-
-void GlobalTable::write(VarIndex v, const void* src) noexcept {
-  const d::BlockRef b = d::block_ref(base_, v);
-  const std::uint64_t w = d::next_write(b);
-  d::write_begin(b, w);
-  d::write_all(b, w, static_cast<const std::byte*>(src));
-  d::write_end(b, w);
-}
-
-ReadOutcome GlobalTable::read_via(VarIndex v, void* dst, std::uint64_t seen, std::uint64_t* scratch) const noexcept {
-  const d::BlockRef b = d::block_ref(base_, v);
+/// The reader of the protocol (GlobalTable::read_via). Here, not in read_via, so that read()
+/// inlines it: calls between a shared library's exported functions go through the PLT.
+inline ReadOutcome read_block(const d::BlockRef& b, void* dst, std::uint64_t seen, std::uint64_t* scratch) noexcept {
   for (int attempt = 0; attempt < d::kMaxReadAttempts; ++attempt) {
     const std::uint64_t now = d::read_version(b);
     if (now == 0) return {Freshness::kNoData, 0};
@@ -72,26 +48,55 @@ ReadOutcome GlobalTable::read_via(VarIndex v, void* dst, std::uint64_t seen, std
   return {seen == 0 ? Freshness::kNoData : Freshness::kOld, seen};
 }
 
+}  // namespace
+
+void GlobalTable::begin_write(VarIndex v) noexcept {
+  const d::BlockRef& b = blocks_[v];
+  d::write_begin(b, d::next_write(b));
+}
+
+void GlobalTable::store_bytes(VarIndex v, std::size_t byte_offset, const void* src, std::size_t bytes) noexcept {
+  const d::BlockRef& b = blocks_[v];
+  d::write_bytes(b, d::next_write(b), byte_offset, static_cast<const std::byte*>(src), bytes);
+}
+
+void GlobalTable::end_write(VarIndex v) noexcept {
+  const d::BlockRef& b = blocks_[v];
+  d::write_end(b, d::next_write(b));
+}
+
+void GlobalTable::write(VarIndex v, const void* src) noexcept {
+  const d::BlockRef& b = blocks_[v];
+  const std::uint64_t w = d::next_write(b);
+  d::write_begin(b, w);
+  d::write_all(b, w, static_cast<const std::byte*>(src));
+  d::write_end(b, w);
+}
+
+ReadOutcome GlobalTable::read_via(VarIndex v, void* dst, std::uint64_t seen, std::uint64_t* scratch) const noexcept {
+  return read_block(blocks_[v], dst, seen, scratch);
+}
+
 ReadOutcome GlobalTable::read(VarIndex v, void* dst, std::uint64_t seen) const noexcept {
-  const std::uint32_t words = d::dir_entry(base_, v)->payload_words;
-  if (words <= kSmallScratchWords) {
+  const d::BlockRef& b = blocks_[v];
+  if (b.words <= kSmallScratchWords) {
     std::array<std::uint64_t, kSmallScratchWords> scratch;  // NOLINT(*-member-init): loaded before use
-    return read_via(v, dst, seen, scratch.data());
+    return read_block(b, dst, seen, scratch.data());
   }
-  if (words <= kLargeScratchWords) {
+  if (b.words <= kLargeScratchWords) {
     // Out of line, so that small reads do not reserve 8 KiB of stack.
     auto large = [&]() __attribute__((noinline)) {
       std::array<std::uint64_t, kLargeScratchWords> scratch;  // NOLINT(*-member-init): loaded before use
-      return read_via(v, dst, seen, scratch.data());
+      return read_block(b, dst, seen, scratch.data());
     };
     return large();
   }
-  return read_via(v, dst, seen, nullptr);
+  return read_block(b, dst, seen, nullptr);
 }
 
 std::uint64_t GlobalTable::version(VarIndex v) const noexcept {
   // Acquire (in read_version): a caller that sees n may rely on write n being whole in its slot.
-  return d::read_version(d::block_ref(base_, v));
+  return d::read_version(blocks_[v]);
 }
 
 void GlobalTable::set_illegal_configuration(bool raised) noexcept {

@@ -108,9 +108,10 @@ class Counter : public Module {
   Out<std::int64_t> count_;
 };
 
-/// Copies in-var `count` to out-var `copy` and counts the cycles that found their input not
-/// renewed since the previous cycle (Freshness::kOld): at a release shared with the producer,
-/// that means it ran before the producer and read the previous instant's value, a cycle of lag.
+/// Copies in-var `count` to out-var `copy` and counts the cycles that read a value older than
+/// the producer's cycle of the same release: a counter started together with it has written
+/// its n-th value at the release of our n-th cycle, so reading less than our cycle number means
+/// we ran before it, a cycle of lag. (Reading more is fine: we are late and catching up.)
 class Follower : public Module {
  public:
   static constexpr const char* kName = "follower";
@@ -133,8 +134,8 @@ class Follower : public Module {
   }
   Status cycle() override {
     copy_[0] = in_[0];
-    if (in_.freshness() == Freshness::kOld) ++lagged_[0];
     ++cycles_[0];
+    if (in_[0] < cycles_[0]) ++lagged_[0];
     return Status::ok();
   }
 

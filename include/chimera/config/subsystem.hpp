@@ -15,9 +15,20 @@ namespace chimera {
 
 enum class SchedulerKind { kRm, kDm, kEdf, kMuf };
 enum class Criticality { kHard, kSoft };
+/// What a periodic task does with releases that passed while a cycle ran late: run each of them
+/// late, one after another (the grid holds, each counts as missed if it ends late), or skip
+/// them and go on at the next release still ahead (each skipped release counts as missed).
+enum class LatePolicy { kRun, kSkip };
 
 std::string_view scheduler_name(SchedulerKind s);
 std::string_view criticality_name(Criticality c);
+std::string_view late_policy_name(LatePolicy p);
+
+/// A sporadic server for an aperiodic task: at most `budget_ns` of execution per `period_ns`.
+struct ServerSpec {
+  std::int64_t budget_ns = 0;
+  std::int64_t period_ns = 0;
+};
 
 /// Where something was written: for messages of the form "file:line: key: problem".
 struct SourceLoc {
@@ -29,10 +40,14 @@ struct TaskSpec {
   std::string name;                       // instance name, unique in the file
   std::string module;                     // module type in the registry
   std::optional<std::int64_t> period_ns;  // absent: aperiodic
-  std::int64_t deadline_ns = 0;           // defaults to the period; 0: none (aperiodic, not given)
+  std::int64_t deadline_ns = 0;           // defaults to the period (the server's period); 0: none
   Criticality criticality = Criticality::kHard;
   std::optional<std::int64_t> wcet_ns;
   std::optional<int> cpu;
+  int priority = 0;                    // user priority, MUF's third level: higher is more urgent
+  LatePolicy late = LatePolicy::kRun;  // default: run for hard tasks, skip for soft ones
+  std::int64_t virtual_exec_ns = 0;    // simulated execution time of a cycle on the virtual clock
+  std::optional<ServerSpec> server;    // aperiodic tasks only
   Params params;
   std::map<std::string, std::string> rename;  // port name -> variable name
   SourceLoc loc;
@@ -50,6 +65,15 @@ struct ConfigurationSpec {
   SourceLoc loc;
 };
 
+/// A switch that a task may ask for while the subsystem runs (paper 3.4: a signal that a dynamic
+/// reconfiguration is required), e.g. a singularity monitor asking for damped least squares.
+struct SwitchRequestSpec {
+  std::string from;  // the configuration that must be on; "" for any
+  std::string to;    // the configuration asked for
+  std::string by;    // the task that may ask; "" for any
+  SourceLoc loc;
+};
+
 struct SubsystemSpec {
   std::string name;
   std::string file;
@@ -60,6 +84,15 @@ struct SubsystemSpec {
   std::vector<TaskSpec> tasks;
   std::vector<ConfigurationSpec> configurations;
   std::string start;  // a configuration name; the loader fills in the first when absent
+  std::vector<SwitchRequestSpec> requests;
+
+  /// The entry that lets task `by` ask for `to` while `from` is on, or nullptr.
+  [[nodiscard]] const SwitchRequestSpec* find_request(std::string_view from, std::string_view to,
+                                                      std::string_view by) const {
+    for (const auto& r : requests)
+      if (r.to == to && (r.from.empty() || r.from == from) && (r.by.empty() || r.by == by)) return &r;
+    return nullptr;
+  }
 
   [[nodiscard]] const TaskSpec* find_task(std::string_view task_name) const {
     for (const auto& t : tasks)

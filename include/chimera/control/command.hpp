@@ -19,6 +19,7 @@ enum class Verb {
   kOff,
   kKill,
   kClear,
+  kSwitch,
   kGet,
   kSet,
   kWait,

@@ -5,6 +5,8 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <utility>
+#include <vector>
 
 namespace chimera {
 
@@ -17,6 +19,8 @@ class LatencyHistogram {
   static constexpr int kBuckets = kSubBuckets * kPowers;
 
   void record(std::int64_t ns) noexcept;
+  /// The buckets that hold records: (upper bound in ns, count), ascending. Not real-time safe.
+  [[nodiscard]] std::vector<std::pair<std::int64_t, std::uint64_t>> nonempty_buckets() const;
   /// The value below which `fraction` of the records fall (bucket upper bound). 0 when empty.
   [[nodiscard]] std::int64_t percentile(double fraction) const noexcept;
   [[nodiscard]] std::uint64_t count() const noexcept;
@@ -37,12 +41,21 @@ class LatencyHistogram {
 /// A copy of a task's figures, for the timing table and --stats-json.
 struct TaskStatsSnapshot {
   std::uint64_t cycles = 0;
-  std::uint64_t missed = 0;  // cycles that finished after their deadline
+  std::uint64_t missed = 0;    // deadlines missed: cycles that ended late, plus skipped releases
+  std::uint64_t overruns = 0;  // cycles that ran longer than the task's wcet budget
+  std::uint64_t skipped = 0;   // releases not run at all (late: skip), each also a missed deadline
   std::int64_t exec_mean_ns = 0;
+  std::int64_t exec_p50_ns = 0;
+  std::int64_t exec_p99_ns = 0;
   std::int64_t exec_max_ns = 0;
   std::int64_t latency_p50_ns = 0;  // release to start of cycle
   std::int64_t latency_p99_ns = 0;
   std::int64_t latency_max_ns = 0;
+  std::int64_t response_p99_ns = 0;  // release to end of cycle, on the subsystem's clock
+  std::int64_t response_max_ns = 0;
+  /// Profiles: (bucket upper bound in ns, count) of the buckets that hold records.
+  std::vector<std::pair<std::int64_t, std::uint64_t>> exec_histogram;
+  std::vector<std::pair<std::int64_t, std::uint64_t>> latency_histogram;
   /// Cycles that started without a same-rate producer's value of the same release because the
   /// producer kept them waiting past the bound (real clock only; see docs/architecture.md).
   std::uint64_t order_timeouts = 0;
@@ -51,8 +64,11 @@ struct TaskStatsSnapshot {
 /// Everything the framework counts for one task. Written only by the task's thread.
 class TaskStats {
  public:
-  /// One finished cycle. Real-time safe.
-  void record_cycle(std::int64_t latency_ns, std::int64_t exec_ns, bool missed) noexcept;
+  /// One finished cycle: release to start, execution time, release to end. Real-time safe.
+  void record_cycle(std::int64_t latency_ns, std::int64_t exec_ns, std::int64_t response_ns, bool missed,
+                    bool overrun) noexcept;
+  /// `n` releases skipped without running (each a missed deadline). Real-time safe.
+  void record_skipped(std::uint64_t n) noexcept;
   /// A precedence wait gave up. Real-time safe.
   void record_order_timeout() noexcept;
   [[nodiscard]] TaskStatsSnapshot snapshot() const noexcept;
@@ -60,8 +76,12 @@ class TaskStats {
 
  private:
   LatencyHistogram latency_;
+  LatencyHistogram exec_;
+  LatencyHistogram response_;
   std::atomic<std::uint64_t> cycles_{0};
   std::atomic<std::uint64_t> missed_{0};
+  std::atomic<std::uint64_t> overruns_{0};
+  std::atomic<std::uint64_t> skipped_{0};
   std::atomic<std::uint64_t> order_timeouts_{0};
   std::atomic<std::int64_t> exec_sum_ns_{0};
   std::atomic<std::int64_t> exec_max_ns_{0};

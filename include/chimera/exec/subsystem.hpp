@@ -16,6 +16,7 @@
 #include "chimera/exec/stats.hpp"
 #include "chimera/lifecycle/state.hpp"
 #include "chimera/module/registry.hpp"
+#include "chimera/reconfig/switch_record.hpp"
 #include "chimera/svt/global_table.hpp"
 
 namespace chimera {
@@ -29,6 +30,9 @@ struct RunOptions {
   std::string shm_suffix;
   /// Ask for SCHED_FIFO and mlockall (real clock); falls back with one warning if refused.
   bool realtime_priorities = true;
+  /// Real clock: measure every task's execution time as its thread's CPU time (profiling), not
+  /// only that of tasks with a wcet budget. Costs two system calls a cycle.
+  bool measure_cpu_time = false;
 };
 
 /// One task as the subsystem interface sees it.
@@ -37,7 +41,7 @@ struct TaskSnapshot {
   std::string module;
   TaskState state = TaskState::kNotCreated;
   std::int64_t period_ns = 0;
-  int cpu = -1;  // -1: not pinned
+  int cpu = 0;  // the CPU it runs on (pinned by the file or assigned)
   TaskStatsSnapshot stats;
   std::string last_error;  // the last method failure, "" if none
 };
@@ -67,7 +71,23 @@ class Subsystem {
   /// Sends a lifecycle signal to one task and waits until its thread has carried it out.
   Result<void> signal(std::string_view task, Signal signal);
   /// Lets the subsystem run for `ns`: simulated time on the virtual clock, a sleep on the real one.
+  /// Switches that tasks ask for are carried out meanwhile (on the virtual clock at the very
+  /// instant they are asked for).
   void run_for(std::int64_t ns);
+
+  /// Dynamic reconfiguration to configuration `name` (paper 3.4, docs/reconfiguration.md): the
+  /// target is verified, its tasks that do not exist yet are created (init) while the current
+  /// configuration runs on, with the illegal-configuration flag raised meanwhile; then at one
+  /// cycle boundary the leaving tasks turn off and the joining ones on, and the tasks that stay
+  /// ON keep their rate without losing a cycle. Consumers of an in-const whose value changed get
+  /// reinit() before their next cycle. An unknown or illegal target, or one with a task in
+  /// ERROR, is refused and nothing changes. `cause` is logged ("operator" by default). Not
+  /// real-time safe.
+  Result<SwitchRecord> switch_to(std::string_view name, std::string_view cause = "operator");
+  /// The configuration that is on now.
+  [[nodiscard]] std::string configuration() const;
+  /// Every switch carried out so far, oldest first.
+  [[nodiscard]] std::vector<SwitchRecord> switches() const;
   /// Off, then kill, every task; removes the shared memory. Idempotent. Afterwards snapshot()
   /// and drain_events() still answer (the run's figures and last events); signal, get and set
   /// are refused, and table() must not be called.
@@ -94,6 +114,9 @@ class Subsystem {
 
  private:
   Subsystem();
+  /// Carries out (or refuses, with an event) the switches tasks asked for.
+  void serve_requests();
+  Result<SwitchRecord> switch_locked(std::string_view name, std::string_view cause, std::int64_t requested_ns);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -13,6 +13,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "chimera/config/verify.hpp"
 #include "chimera/core/result.hpp"
@@ -30,6 +31,10 @@ class Task {
   static constexpr std::size_t kEventCapacity = 64;
 
   Task(const ResolvedTask& resolved, GlobalTable& table, const SubsystemFlags& flags);
+  /// Whether the task has an in-const bound to variable `name`.
+  [[nodiscard]] bool reads_const(std::string_view name) const;
+  /// The names of the variables its out-consts are bound to.
+  [[nodiscard]] std::vector<std::string> const_outputs() const;
   ~Task();
   Task(const Task&) = delete;
   Task& operator=(const Task&) = delete;
@@ -49,12 +54,45 @@ class Task {
   /// A signal the current state does not allow is refused and changes nothing.
   Result<void> apply(Signal signal, std::int64_t now_ns);
 
-  /// One cycle released at `release_ns` and started at `start_ns` (subsystem clock): in-vars
-  /// in, cycle(), out-vars out, statistics, and the error path if cycle() fails. Does nothing
-  /// unless ON. On the virtual clock a cycle takes no simulated time. Real-time safe for the
-  /// framework's part.
-  void run_cycle(std::int64_t release_ns, std::int64_t start_ns, std::int64_t deadline_ns,
-                 bool clock_is_virtual) noexcept;
+  /// How a job's execution time is measured on the real clock.
+  enum class ExecClock : std::uint8_t {
+    kWall,  // CLOCK_MONOTONIC from start to end (includes preemption); cheap
+    kCpu,   // the thread's CPU time: exact, two system calls a cycle (tasks with a wcet, profiling)
+  };
+
+  /// Starts one job released at `release_ns`, at `start_ns` (subsystem clock): in-vars in, sync()
+  /// for an aperiodic task, then cycle(); a failure takes the error path. The job's outputs stay
+  /// in the local table until end_job(). Returns the job's simulated execution time for the
+  /// virtual clock (the task's virtual_exec plus what the module charged), or -1 if the task is
+  /// not ON. Real-time safe for the framework's part.
+  std::int64_t begin_job(std::int64_t release_ns, std::int64_t start_ns) noexcept;
+  /// Ends the job begun last at `end_ns`: out-vars out, statistics, timing checks. `used_ns` is
+  /// the execution time that counts against the wcet budget (simulated on the virtual clock; -1:
+  /// measure it, real clock). A deadline miss or budget overrun of a hard task calls error()
+  /// (ERROR unless it recovers); a soft task only counts it. Returns the execution time counted
+  /// (`used_ns`, or what was measured). Real-time safe.
+  std::int64_t end_job(std::int64_t end_ns, std::int64_t used_ns) noexcept;
+  /// Whether a job has begun and not yet ended.
+  [[nodiscard]] bool job_open() const noexcept { return job_.open; }
+  /// A producer of one of its in-consts changed its value (a switch): the new values are read
+  /// into the local table, then reinit(); a failure takes the error path. Between cycles only,
+  /// on the task's thread. Returns whether the task is still ON. Real-time safe for the framework.
+  bool reinit(std::int64_t now_ns) noexcept;
+  /// How many times reinit() ran since spawn.
+  [[nodiscard]] std::uint64_t reinits() const noexcept { return reinits_.load(std::memory_order_relaxed); }
+  /// `n` releases that will not run (late: skip), each a missed deadline; a hard task gets
+  /// error(). Real-time safe.
+  void skip_releases(std::uint64_t n, std::int64_t now_ns) noexcept;
+  /// The deadline of a job released at `release_ns` (0 relative deadline: none, INT64_MAX).
+  [[nodiscard]] std::int64_t absolute_deadline(std::int64_t release_ns) const noexcept;
+  /// What wakes this aperiodic task, as its module declared in init (empty for periodic ones).
+  [[nodiscard]] const Trigger& trigger() const noexcept { return trigger_; }
+  /// Real clock: how exec times are measured (set before spawn).
+  void set_exec_clock(ExecClock clock) noexcept { exec_clock_ = clock; }
+  /// Marks the subsystem's clock as virtual in the timing modules see (set before spawn).
+  void set_virtual_clock(bool is_virtual) noexcept { virtual_clock_ = is_virtual; }
+  /// Where its module's switch requests go, and its index there (set before spawn).
+  void set_request_board(RequestBoard* board, int index) noexcept { services_ = {board, index}; }
 
   [[nodiscard]] const TaskStats& stats() const { return stats_; }
   /// The executive gave up waiting for a same-rate producer. Real-time safe.
@@ -81,6 +119,9 @@ class Task {
   /// The paper's error rule after `hook` failed with `failure`: error() may recover (true);
   /// otherwise the task enters ERROR (false). Real-time safe.
   bool recover(Hook hook, Status failure, std::int64_t now_ns) noexcept;
+  /// The same rule for a timing failure the framework detected. Real-time safe.
+  void timing_fault(Fault fault, std::int64_t now_ns) noexcept;
+  [[nodiscard]] std::int64_t exec_clock_now() const noexcept;
   void set_state(TaskState s) noexcept;
   void destroy_module() noexcept;
 
@@ -92,6 +133,19 @@ class Task {
   std::unique_ptr<Module> module_;
   std::unique_ptr<LocalTable> local_;
   CycleTiming timing_;
+  Trigger trigger_;
+  TaskServices services_;
+  ExecClock exec_clock_ = ExecClock::kWall;
+  bool virtual_clock_ = false;
+  struct Job {
+    bool open = false;
+    bool failed = false;          // the error path already ran (and published)
+    std::int64_t release_ns = 0;  // subsystem clock
+    std::int64_t start_ns = 0;    // subsystem clock
+    std::int64_t exec_start = 0;  // on exec_clock_
+  } job_;
+  std::uint64_t timing_faults_ = 0;  // recovered ones too: events are sent at 1, 2, 4, 8...
+  std::atomic<std::uint64_t> reinits_{0};
   TaskStats stats_;
   EventRing<kEventCapacity> events_;
   std::array<char, 160> exception_text_{};

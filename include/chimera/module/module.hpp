@@ -42,13 +42,24 @@
 
 namespace chimera {
 
+/// Why the framework called error(): a method that failed, or a timing failure it detected.
+enum class Fault : std::uint8_t {
+  kNone,
+  kMethodFailed,    // a method returned a failure or threw
+  kDeadlineMissed,  // a cycle ended after its deadline, or a release was skipped past its deadline
+  kBudgetOverrun,   // a cycle ran longer than the task's declared wcet
+};
+
 /// Timing of the current cycle, kept up to date by the framework; modules read it through the
 /// reference InitContext::timing() hands out. Times come from the subsystem's clock (real or
 /// virtual), so modules that use them stay deterministic on the virtual clock.
 struct CycleTiming {
   std::int64_t release_ns = 0;  // nominal release of the current cycle, since subsystem start
+  std::int64_t start_ns = 0;    // when the current cycle started, same clock
   std::int64_t period_ns = 0;   // 0 for an aperiodic task
   std::uint64_t cycle = 0;      // cycles completed before this one
+  bool virtual_clock = false;   // the subsystem runs on the simulated clock
+  Fault fault = Fault::kNone;   // during error(): what went wrong
 };
 
 /// Read-only facts about the running subsystem that any module may look at.
@@ -59,12 +70,63 @@ class SubsystemFlags {
   [[nodiscard]] virtual bool illegal_configuration() const noexcept = 0;
 };
 
+/// Where a module's requests for a dynamic reconfiguration go: the subsystem interface, which
+/// carries one out when the file's `requests:` allow it. Implemented by the framework.
+class RequestBoard {
+ public:
+  virtual ~RequestBoard() = default;
+  /// The index of configuration `name`, or -1 if the file has none of that name. Not real-time safe.
+  [[nodiscard]] virtual int configuration_index(std::string_view name) const = 0;
+  /// Task `task` asks for configuration `configuration`. Real-time safe.
+  virtual void post(int task, int configuration) noexcept = 0;
+};
+
+/// A switch a module may ask for (paper 3.4: "a signal is sent to the subsystem interface
+/// indicating that a dynamic reconfiguration is required"), resolved by name in init.
+class SwitchRequest {
+ public:
+  SwitchRequest() = default;
+  SwitchRequest(RequestBoard* board, int task, int configuration)
+      : board_(board), task_(task), configuration_(configuration) {}
+  /// Asks for the switch; asking again while it is pending or done changes nothing. Real-time safe.
+  void ask() const noexcept {
+    if (board_ != nullptr) board_->post(task_, configuration_);
+  }
+  [[nodiscard]] bool bound() const noexcept { return board_ != nullptr; }
+
+ private:
+  RequestBoard* board_ = nullptr;
+  int task_ = -1;
+  int configuration_ = -1;
+};
+
+/// What wakes an aperiodic task (paper 3.3: events arrive through its resource port). A periodic
+/// task's trigger is its timer and this stays empty.
+struct Trigger {
+  int fd = -1;              // a cycle each time this descriptor is readable (socket, timerfd, pipe)
+  std::string update_port;  // a cycle each time this in-var gets a new value ("" for none)
+  [[nodiscard]] bool any() const { return fd >= 0 || !update_port.empty(); }
+};
+
+/// The framework's services for one task: where its switch requests go (may be null), and which
+/// task it is there.
+struct TaskServices {
+  RequestBoard* requests = nullptr;
+  int task_index = -1;
+};
+
 /// What a module receives in init(): its parameters, its typed port views, its timing.
 class InitContext {
  public:
   InitContext(std::string_view task_name, const Params& params, LocalTable& local, const CycleTiming& timing,
-              const SubsystemFlags& flags)
-      : task_name_(task_name), params_(params), local_(local), timing_(timing), flags_(flags) {}
+              const SubsystemFlags& flags, Trigger& trigger, TaskServices services = {})
+      : task_name_(task_name),
+        params_(params),
+        local_(local),
+        timing_(timing),
+        flags_(flags),
+        trigger_(trigger),
+        services_(services) {}
 
   /// A view onto input port `port` (in-var or in-const). A wrong name, kind or element type
   /// returns an unbound view and makes init fail with a message naming the port.
@@ -82,6 +144,24 @@ class InitContext {
     if (r) return *r;
     note_failure(r.error().message);
     return {};
+  }
+
+  /// Aperiodic tasks: run a cycle (after sync()) each time `fd` is readable. The module owns the
+  /// descriptor and closes it in kill(). Level-triggered: sync() should take one event.
+  void trigger_on_fd(int fd) { trigger_.fd = fd; }
+  /// Aperiodic tasks: run a cycle each time in-var `port` is written anew by its producer.
+  void trigger_on_update(std::string_view port) { trigger_.update_port = std::string(port); }
+
+  /// A handle to ask, from cycle(), for a switch to configuration `configuration` of the file.
+  /// An unknown name makes init fail with a message naming it. Whether the switch is allowed is
+  /// the file's `requests:` to say, when it is asked for.
+  SwitchRequest switch_request(std::string_view configuration) {
+    const int index = services_.requests != nullptr ? services_.requests->configuration_index(configuration) : -1;
+    if (index < 0) {
+      note_failure("no configuration named '" + std::string(configuration) + "' to ask a switch to");
+      return {};
+    }
+    return SwitchRequest(services_.requests, services_.task_index, index);
   }
 
   [[nodiscard]] const Params& params() const { return params_; }
@@ -104,6 +184,8 @@ class InitContext {
   LocalTable& local_;
   const CycleTiming& timing_;
   const SubsystemFlags& flags_;
+  Trigger& trigger_;
+  TaskServices services_;
   std::string binding_error_;
 };
 
@@ -136,11 +218,18 @@ class Module {
   virtual Status clear() { return Status::ok(); }
   /// An in-const changed (another producer of it joined); the new values are in the views.
   virtual Status reinit() { return Status::ok(); }
-  /// Aperiodic tasks: wait for the next event on the resource port.
+  /// Aperiodic tasks: the trigger declared in init fired; take the event from the resource port
+  /// (without blocking) before cycle() processes it. A failure skips the cycle (error path).
   virtual Status sync() { return Status::ok(); }
 
+  /// On the virtual clock, makes the current cycle take `ns` more simulated time (what-if
+  /// studies, injected overruns); on the real clock time is measured and this does nothing.
+  /// Real-time safe.
+  void consume_virtual_time(std::int64_t ns) noexcept { virtual_ns_ += ns > 0 ? ns : 0; }
+
  private:
-  friend class Task;  // the framework's non-virtual interface calls the hooks above
+  friend class Task;             // the framework's non-virtual interface calls the hooks above
+  std::int64_t virtual_ns_ = 0;  // charged by the current method; read and reset by the Task
 };
 
 }  // namespace chimera

@@ -11,12 +11,17 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "chimera/core/result.hpp"
 #include "chimera/svt/elem_type.hpp"
 #include "chimera/svt/freshness.hpp"
 
 namespace chimera {
+
+namespace svt_detail {
+struct BlockRef;  // src/svt/shm_layout.hpp
+}  // namespace svt_detail
 
 /// Index of a variable in the global table; resolved once, used on the real-time path.
 using VarIndex = std::uint32_t;
@@ -77,6 +82,7 @@ class GlobalTable {
 
   GlobalTable() = default;
   void release() noexcept;
+  void locate_blocks();
   // The reader of the protocol. Loads the words into `scratch` (at least as many words as the
   // payload) and copies to `dst` only once they are known to be whole; with no scratch it loads
   // straight into `dst`, and then on exhausted retries zeros dst and reports kNoData.
@@ -84,6 +90,10 @@ class GlobalTable {
 
   std::string shm_name_;
   std::byte* base_ = nullptr;  // start of the mapping; everything inside is found by offset
+  // Each variable's block in this process's mapping, located once through the directory when the
+  // table is created or attached, so that reads and writes skip the directory. Process-local
+  // pointers; the region itself holds only offsets.
+  std::vector<svt_detail::BlockRef> blocks_;
   std::size_t mapped_bytes_ = 0;
   bool owner_ = false;
 };

@@ -9,6 +9,8 @@
 namespace chimera::config_detail {
 namespace {
 
+constexpr int kMaxUserPriority = 1000;
+
 Result<const ModuleInfo*> read_module(const Source& source, const Field& field, const Registry& registry) {
   auto name = read_text(source, field);
   if (!name) return name.error();
@@ -58,6 +60,56 @@ Result<void> read_criticality(const Source& source, const MapReader& map, TaskSp
     task.criticality = Criticality::kSoft;
   } else {
     return source.fail(*f, fmt::format("{} is not a criticality (use hard or soft)", describe(f->node)));
+  }
+  return {};
+}
+
+// priority, late, virtual_exec and server: how the executive treats the task (docs/scheduling.md).
+Result<void> read_scheduling(const Source& source, const MapReader& map, TaskSpec& task) {
+  if (const auto f = map.get("priority")) {
+    auto n = read_number(source, *f);
+    if (!n) return n.error();
+    if (*n != static_cast<double>(static_cast<int>(*n)) || *n < -kMaxUserPriority || *n > kMaxUserPriority)
+      return source.fail(*f, fmt::format("{} is not a whole number from -{} to {}", describe(f->node), kMaxUserPriority,
+                                         kMaxUserPriority));
+    task.priority = static_cast<int>(*n);
+  }
+  task.late = task.criticality == Criticality::kSoft ? LatePolicy::kSkip : LatePolicy::kRun;
+  if (const auto f = map.get("late")) {
+    const std::string text = f->node.IsScalar() ? f->node.Scalar() : std::string();
+    if (text == "run") {
+      task.late = LatePolicy::kRun;
+    } else if (text == "skip") {
+      task.late = LatePolicy::kSkip;
+    } else {
+      return source.fail(*f, fmt::format("{} is not a late-cycle policy (use run or skip)", describe(f->node)));
+    }
+    if (!task.period_ns) return source.fail(*f, "only a periodic task has releases to run late or skip");
+  }
+  if (const auto f = map.get("virtual_exec")) {
+    auto ns = read_duration(source, *f);
+    if (!ns) return ns.error();
+    task.virtual_exec_ns = *ns;
+  }
+  if (const auto f = map.get("server")) {
+    if (task.period_ns)
+      return source.fail(*f, "a server is for an aperiodic task (this one has a period; remove one of them)");
+    auto server = MapReader::create(source, *f, "a server", {"budget", "period"});
+    if (!server) return server.error();
+    ServerSpec spec;
+    for (auto [key, out] : {std::pair{"budget", &spec.budget_ns}, std::pair{"period", &spec.period_ns}}) {
+      auto field =
+          server->require(source, key, "a server has a budget and a period, e.g. { budget: 1ms, period: 10ms }");
+      if (!field) return field.error();
+      auto ns = read_duration(source, *field);
+      if (!ns) return ns.error();
+      if (*ns <= 0) return source.fail(*field, "must be greater than zero");
+      *out = *ns;
+    }
+    if (spec.budget_ns > spec.period_ns)
+      return source.fail(*server->get("budget"), "the budget cannot be longer than the server's period");
+    task.server = spec;
+    if (!map.get("deadline")) task.deadline_ns = spec.period_ns;  // an event is served within a period
   }
   return {};
 }
@@ -148,9 +200,9 @@ Result<void> read_rename(const Source& source, const Field& field, const ModuleI
 
 Result<TaskSpec> load_task(const Source& source, const Field& task_field, const SubsystemSpec& file,
                            const Registry& registry) {
-  auto map = MapReader::create(
-      source, task_field, "a task",
-      {"name", "module", "period", "frequency", "deadline", "criticality", "wcet", "cpu", "params", "rename"});
+  auto map = MapReader::create(source, task_field, "a task",
+                               {"name", "module", "period", "frequency", "deadline", "criticality", "wcet", "cpu",
+                                "priority", "late", "virtual_exec", "server", "params", "rename"});
   if (!map) return map.error();
   TaskSpec task;
   task.loc = SourceLoc{source.file(), task_field.line};
@@ -171,6 +223,7 @@ Result<TaskSpec> load_task(const Source& source, const Field& task_field, const 
 
   if (auto ok = read_timing(source, *map, task); !ok) return ok.error();
   if (auto ok = read_criticality(source, *map, task); !ok) return ok.error();
+  if (auto ok = read_scheduling(source, *map, task); !ok) return ok.error();
   if (auto ok = read_cpu(source, *map, file.cpus, task); !ok) return ok.error();
   auto params = read_params(source, map->get("params"), **info);
   if (!params) return params.error();

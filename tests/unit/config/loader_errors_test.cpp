@@ -48,7 +48,7 @@ TEST(LoaderErrors, MoreThanOneDocument) {
 TEST(LoaderErrors, UnknownTopLevelKey) {
   EXPECT_EQ(error_of(std::string("subsystem: s\nschedular: rm\n") + kOneTask),
             "pid.yaml:2: schedular: unknown key (known: subsystem, scheduler, cpus, plugins, constants, tasks, "
-            "configurations, start)");
+            "configurations, start, requests)");
 }
 
 TEST(LoaderErrors, KeyWrittenTwice) {
@@ -131,7 +131,7 @@ tasks:
     perod: 10ms
 )"),
             "pid.yaml:5: tasks[0].perod: unknown key (known: name, module, period, frequency, deadline, criticality, "
-            "wcet, cpu, params, rename)");
+            "wcet, cpu, priority, late, virtual_exec, server, params, rename)");
 }
 
 TEST(LoaderErrors, MissingNameOrModule) {
@@ -172,7 +172,8 @@ tasks:
 
 TEST(LoaderErrors, UnknownModule) {
   EXPECT_EQ(error_of("subsystem: s\ntasks:\n  - name: a\n    module: pidd\n"),
-            "pid.yaml:4: tasks[0].module: no module named pidd (known: bad_sized, damped_least_squares, f32_logger, "
+            "pid.yaml:4: tasks[0].module: no module named pidd (known: any_logger, bad_sized, damped_least_squares, "
+            "f32_logger, "
             "fwd_kin_jacobian, inv_kin, join_weighted_average, joint_traj_gen, pid_joint, robot_position, "
             "robot_torque, time_integrator, visual_servo)");
   const Registry empty;
@@ -241,6 +242,35 @@ TEST(LoaderErrors, BadDeadlineAndWcet) {
 TEST(LoaderErrors, BadCriticality) {
   EXPECT_EQ(error_of("subsystem: s\ntasks:\n  - {name: a, module: visual_servo, criticality: firm}\n"),
             "pid.yaml:3: tasks[0].criticality: \"firm\" is not a criticality (use hard or soft)");
+}
+
+TEST(LoaderErrors, BadSchedulingKeys) {
+  const std::string periodic = "subsystem: s\ntasks:\n  - name: a\n    module: visual_servo\n    period: 10ms\n";
+  const std::string aperiodic = "subsystem: s\ntasks:\n  - name: a\n    module: visual_servo\n";
+  EXPECT_EQ(error_of(periodic + "    priority: 1.5\n"),
+            "pid.yaml:6: tasks[0].priority: \"1.5\" is not a whole number from -1000 to 1000");
+  EXPECT_EQ(error_of(periodic + "    priority: 5000\n"),
+            "pid.yaml:6: tasks[0].priority: \"5000\" is not a whole number from -1000 to 1000");
+  EXPECT_EQ(error_of(periodic + "    late: later\n"),
+            "pid.yaml:6: tasks[0].late: \"later\" is not a late-cycle policy (use run or skip)");
+  EXPECT_EQ(error_of(aperiodic + "    late: skip\n"),
+            "pid.yaml:5: tasks[0].late: only a periodic task has releases to run late or skip");
+  EXPECT_EQ(error_of(periodic + "    virtual_exec: 2 ms\n"),
+            "pid.yaml:6: tasks[0].virtual_exec: \"2 ms\" is not a duration (use ns, us, ms or s, e.g. 10ms)");
+  EXPECT_EQ(error_of(periodic + "    server: {budget: 1ms, period: 10ms}\n"),
+            "pid.yaml:6: tasks[0].server: a server is for an aperiodic task (this one has a period; remove one of "
+            "them)");
+  EXPECT_EQ(error_of(aperiodic + "    server: {budget: 1ms}\n"),
+            "pid.yaml:5: tasks[0].server.period: missing (a server has a budget and a period, e.g. { budget: 1ms, "
+            "period: 10ms })");
+  EXPECT_EQ(error_of(aperiodic + "    server: {budget: 1ms, period: 10ms, kind: deferrable}\n"),
+            "pid.yaml:5: tasks[0].server.kind: unknown key (known: budget, period)");
+  EXPECT_EQ(error_of(aperiodic + "    server: {budget: 0ms, period: 10ms}\n"),
+            "pid.yaml:5: tasks[0].server.budget: must be greater than zero");
+  EXPECT_EQ(error_of(aperiodic + "    server: {budget: 11ms, period: 10ms}\n"),
+            "pid.yaml:5: tasks[0].server.budget: the budget cannot be longer than the server's period");
+  EXPECT_EQ(error_of(aperiodic + "    server: 10ms\n"),
+            "pid.yaml:5: tasks[0].server: a server must be a mapping of keys, not \"10ms\"");
 }
 
 TEST(LoaderErrors, BadCpu) {

@@ -116,6 +116,44 @@ tasks:
   EXPECT_EQ(s.tasks[2].criticality, Criticality::kSoft);
 }
 
+TEST(LoadSubsystem, SchedulingKeysAndTheirDefaults) {
+  const auto s = load_ok(R"(subsystem: s
+scheduler: muf
+tasks:
+  - {name: hard, module: visual_servo, period: 1ms}
+  - {name: soft, module: visual_servo, period: 1ms, criticality: soft}
+  - name: tuned
+    module: visual_servo
+    period: 2ms
+    criticality: soft
+    late: run
+    priority: -3
+    virtual_exec: 300us
+  - name: events
+    module: visual_servo
+    server: { budget: 1ms, period: 10ms }
+  - name: events_by_deadline
+    module: visual_servo
+    deadline: 4ms
+    server: { budget: 1ms, period: 10ms }
+)");
+  EXPECT_EQ(s.tasks[0].late, LatePolicy::kRun);   // a hard task runs every release
+  EXPECT_EQ(s.tasks[1].late, LatePolicy::kSkip);  // a soft one skips what it missed
+  EXPECT_EQ(s.tasks[0].priority, 0);
+  EXPECT_EQ(s.tasks[0].virtual_exec_ns, 0);
+  EXPECT_FALSE(s.tasks[0].server.has_value());
+  EXPECT_EQ(s.tasks[2].late, LatePolicy::kRun);
+  EXPECT_EQ(s.tasks[2].priority, -3);
+  EXPECT_EQ(s.tasks[2].virtual_exec_ns, 300'000);
+  ASSERT_TRUE(s.tasks[3].server.has_value());
+  EXPECT_EQ(s.tasks[3].server->budget_ns, 1'000'000);
+  EXPECT_EQ(s.tasks[3].server->period_ns, 10'000'000);
+  EXPECT_EQ(s.tasks[3].deadline_ns, 10'000'000);  // an event is served within the server's period
+  EXPECT_EQ(s.tasks[4].deadline_ns, 4'000'000);
+  EXPECT_EQ(late_policy_name(LatePolicy::kRun), "run");
+  EXPECT_EQ(late_policy_name(LatePolicy::kSkip), "skip");
+}
+
 TEST(LoadSubsystem, ParameterValuesOfEveryType) {
   const auto s = load_ok(R"(subsystem: s
 tasks:

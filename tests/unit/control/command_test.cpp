@@ -81,13 +81,14 @@ TEST(ParseCommand, EmptyLineIsNoCommand) {
 TEST(ParseCommand, BadArityNamesTheUsage) {
   for (const char* line :
        {"status now", "spawn", "spawn a b", "on", "off", "kill", "kill a b", "clear", "clear a b", "get", "get a b",
-        "set", "set theta_d", "wait", "wait 1s 2s", "stats all", "quit now", "help on"}) {
+        "set", "set theta_d", "wait", "wait 1s 2s", "stats a b", "quit now", "help on"}) {
     const std::string message = refusal(line);
     EXPECT_NE(message.find("usage:"), std::string::npos) << line << ": " << message;
   }
   EXPECT_EQ(refusal("kill a b"), "kill takes 1 argument (usage: kill TASK)");
   EXPECT_EQ(refusal("on"), "on takes at least 1 argument (usage: on TASK..)");
   EXPECT_EQ(refusal("status x"), "status takes no arguments (usage: status)");
+  EXPECT_EQ(refusal("stats a b"), "stats takes at most 1 argument (usage: stats [TASK])");
 }
 
 TEST(ParseCommand, BadDurations) {

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <map>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -104,10 +105,13 @@ TEST_F(ControlTest, StatusIsATableOfEveryTask) {
   EXPECT_EQ(r.text.rfind("task", 0), 0U) << r.text;
   for (const char* header : {"module", "state", "period", "cycles", "missed"})
     EXPECT_NE(r.text.find(header), std::string::npos) << header;
-  // task module state period(2 words) cycles missed
-  EXPECT_EQ(status_row("counter"), (std::vector<std::string>{"counter", "test_counter", "ON", "1", "ms", "10", "0"}));
+  // task module state cpu period(2 words) cycles missed; the cpu is the plan's assignment
+  std::map<std::string, std::string> cpu;
+  for (const auto& t : subsystem_->snapshot()) cpu[t.name] = std::to_string(t.cpu);
+  EXPECT_EQ(status_row("counter"),
+            (std::vector<std::string>{"counter", "test_counter", "ON", cpu["counter"], "1", "ms", "10", "0"}));
   EXPECT_EQ(status_row("spare"),
-            (std::vector<std::string>{"spare", "test_counter", "NOT-CREATED", "2", "ms", "0", "0"}));
+            (std::vector<std::string>{"spare", "test_counter", "NOT-CREATED", cpu["spare"], "2", "ms", "0", "0"}));
 }
 
 TEST_F(ControlTest, SignalsAreReflectedInStatus) {
@@ -120,7 +124,7 @@ TEST_F(ControlTest, SignalsAreReflectedInStatus) {
   EXPECT_EQ(run("on spare doubler").text, "spare: ON\ndoubler: ON\n");
   EXPECT_EQ(status_row("spare").at(2), "ON");
   subsystem_->run_for(10 * kMs);
-  EXPECT_EQ(status_row("spare").at(5), "5");  // 2 ms period
+  EXPECT_EQ(status_row("spare").at(6), "5");  // 2 ms period
 
   EXPECT_EQ(run("kill spare").text, "spare: NOT-CREATED\n");
   EXPECT_EQ(status_row("spare").at(2), "NOT-CREATED");
@@ -233,6 +237,24 @@ TEST_F(ControlTest, StatsIsTheTimingTable) {
   for (const char* header : {"exec mean", "exec max", "latency p50", "latency p99", "latency max"})
     EXPECT_NE(r.text.find(header), std::string::npos) << header;
   EXPECT_NE(r.text.find("counter"), std::string::npos);
+}
+
+TEST_F(ControlTest, StatsOfOneTaskIsItsProfile) {
+  subsystem_->run_for(10 * kMs);
+  const Reply r = run("stats counter");
+  ASSERT_TRUE(r.ok) << r.text;
+  EXPECT_EQ(r.text.rfind("counter (test_counter), ON, cpu ", 0), 0U) << r.text;
+  EXPECT_NE(r.text.find("  cycles 10, missed 0, overruns 0, skipped 0"), std::string::npos) << r.text;
+  EXPECT_NE(r.text.find("execution time:\n  <= "), std::string::npos) << r.text;
+  // On the virtual clock every release starts on time: one bucket, all ten cycles, a full bar.
+  EXPECT_NE(r.text.find("release latency:\n  <=       0 ns        10  ########################################\n"),
+            std::string::npos)
+      << r.text;
+  const Reply spare = run("stats spare");
+  EXPECT_NE(spare.text.find("execution time:\n  (no cycles yet)\n"), std::string::npos) << spare.text;
+  const Reply bad = run("stats nosuch");
+  EXPECT_FALSE(bad.ok);
+  EXPECT_EQ(bad.text, "unknown task 'nosuch'\n");
 }
 
 TEST_F(ControlTest, HelpUnknownAndBlankLines) {

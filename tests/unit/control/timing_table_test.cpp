@@ -19,7 +19,14 @@ std::vector<TaskSnapshot> sample() {
   pid.module = "pid_joint";
   pid.state = TaskState::kOn;
   pid.period_ns = 1'000'000;
-  pid.stats = {2000, 3, 12'345, 250'000, 800, 40'000, 1'500'000};
+  pid.cpu = 1;
+  pid.stats.cycles = 2000;
+  pid.stats.missed = 3;
+  pid.stats.exec_mean_ns = 12'345;
+  pid.stats.exec_max_ns = 250'000;
+  pid.stats.latency_p50_ns = 800;
+  pid.stats.latency_p99_ns = 40'000;
+  pid.stats.latency_max_ns = 1'500'000;
   TaskSnapshot traj;
   traj.name = "traj";
   traj.module = "joint_traj_gen";
@@ -69,9 +76,9 @@ TEST(StatusTable, OneRowPerTask) {
   const auto text = status_table(sample());
   const auto lines = lines_of(text);
   ASSERT_EQ(lines.size(), 3U);
-  EXPECT_EQ(lines[0], "task  module          state        period  cycles  missed");
-  EXPECT_EQ(lines[1], "pid   pid_joint       ON             1 ms    2000       3");
-  EXPECT_EQ(lines[2], "traj  joint_traj_gen  NOT-CREATED   10 ms       0       0");
+  EXPECT_EQ(lines[0], "task  module          state        cpu  period  cycles  missed");
+  EXPECT_EQ(lines[1], "pid   pid_joint       ON             1    1 ms    2000       3");
+  EXPECT_EQ(lines[2], "traj  joint_traj_gen  NOT-CREATED    0   10 ms       0       0");
 }
 
 TEST(StatusTable, ShowsTheLastErrorWhenThereIsOne) {

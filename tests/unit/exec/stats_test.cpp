@@ -30,14 +30,24 @@ TEST(LatencyHistogram, PercentilesOfAKnownDistribution) {
 
 TEST(TaskStats, CountsCyclesMissesAndExecutionTimes) {
   TaskStats s;
-  s.record_cycle(100, 1000, false);
-  s.record_cycle(300, 3000, true);
+  s.record_cycle(100, 1000, 1100, false, false);
+  s.record_cycle(300, 3000, 3300, true, true);
+  s.record_skipped(2);
   const auto snap = s.snapshot();
   EXPECT_EQ(snap.cycles, 2u);
-  EXPECT_EQ(snap.missed, 1u);
+  EXPECT_EQ(snap.missed, 3u);  // one late cycle, two skipped releases
+  EXPECT_EQ(snap.skipped, 2u);
+  EXPECT_EQ(snap.overruns, 1u);
   EXPECT_EQ(snap.exec_mean_ns, 2000);
   EXPECT_EQ(snap.exec_max_ns, 3000);
   EXPECT_EQ(snap.latency_max_ns, 300);
+  EXPECT_EQ(snap.response_max_ns, 3300);
+  // The profile: one bucket per distinct value here, each holding one record.
+  ASSERT_EQ(snap.exec_histogram.size(), 2u);
+  EXPECT_NEAR(static_cast<double>(snap.exec_histogram[0].first), 1000.0, 1000.0 * 0.04);
+  EXPECT_EQ(snap.exec_histogram[0].second, 1u);
+  EXPECT_NEAR(static_cast<double>(snap.exec_histogram[1].first), 3000.0, 3000.0 * 0.04);
+  ASSERT_EQ(snap.latency_histogram.size(), 2u);
 }
 
 }  // namespace

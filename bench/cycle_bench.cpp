@@ -1,0 +1,120 @@
+// Framework cost per cycle of the PID task of Figure 4, without the kernel's wake-up: what
+// Task::run_cycle does around the module's cycle() (pull four 6-double in-vars, push tau_r,
+// two clock reads, statistics), measured with a module that has pid_joint's ports and an empty
+// cycle (bench_null_pid). Each iteration first writes the four inputs, as the producers would,
+// so every pull copies new values; BM_ProducerWrites alone is subtracted by bench/run.py:
+//   cycle_overhead_ns = BM_PidCycleFramework - BM_ProducerWrites.
+// BM_PidCycleReal runs the real pid_joint for comparison.
+
+#include <unistd.h>
+
+#include <array>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <string>
+
+#include <benchmark/benchmark.h>
+#include <fmt/format.h>
+
+#include "chimera/config/loader.hpp"
+#include "chimera/config/verify.hpp"
+#include "chimera/exec/task.hpp"
+#include "chimera/svt/global_table.hpp"
+
+namespace chimera::bench {
+namespace {
+
+struct NoFlags final : SubsystemFlags {
+  [[nodiscard]] bool illegal_configuration() const noexcept override { return false; }
+};
+
+[[noreturn]] void die(const std::string& what) {
+  std::fprintf(stderr, "cycle_bench: %s\n", what.c_str());
+  std::abort();
+}
+
+/// Figure 4's variables in a global table, and one task bound to them.
+class PidFixture {
+ public:
+  explicit PidFixture(const std::string& module) {
+    const std::string yaml = fmt::format(
+        "subsystem: bench_cycle\nconstants:\n  ndof: 6\ntasks:\n  - name: pid\n    module: {}\n    period: 1ms\n"
+        "configurations:\n  c: [pid]\n",
+        module);
+    auto spec = load_subsystem_text(yaml, "cycle_bench.yaml", Registry::global());
+    if (!spec) die(spec.error().message);
+    spec_ = std::make_unique<SubsystemSpec>(std::move(*spec));
+    resolution_ = std::make_unique<Resolution>(resolve_subsystem(*spec_, Registry::global()));
+    auto table =
+        GlobalTable::create(fmt::format("bench_cycle_{}_{}", ::getpid(), counter_++), resolution_->subsystem.variables);
+    if (!table) die(table.error().message);
+    table_ = std::make_unique<GlobalTable>(std::move(*table));
+    const double ndof = 6;
+    table_->write(*table_->find("ndof"), &ndof);
+    for (const char* v : {"theta_d", "dtheta_d", "theta_m", "dtheta_m"}) inputs_[n_inputs_++] = *table_->find(v);
+    task_ = std::make_unique<Task>(resolution_->subsystem.tasks.front(), *table_, flags_);
+    if (auto r = task_->apply(Signal::kSpawn, 0); !r) die(r.error().message);
+    if (auto r = task_->apply(Signal::kOn, 0); !r) die(r.error().message);
+  }
+  PidFixture(const PidFixture&) = delete;
+  PidFixture& operator=(const PidFixture&) = delete;
+  ~PidFixture() { (void)task_->apply(Signal::kKill, 0); }
+
+  /// The producers' part of a period: four new 6-double values.
+  void write_inputs() noexcept {
+    values_[0] += 1e-3;
+    for (std::size_t i = 0; i < n_inputs_; ++i) table_->write(inputs_[i], values_.data());
+  }
+  void cycle() noexcept {
+    task_->run_cycle(release_, release_, 1'000'000, /*clock_is_virtual=*/true);
+    release_ += 1'000'000;
+  }
+
+ private:
+  static inline int counter_ = 0;
+  NoFlags flags_;
+  std::unique_ptr<SubsystemSpec> spec_;
+  std::unique_ptr<Resolution> resolution_;
+  std::unique_ptr<GlobalTable> table_;
+  std::unique_ptr<Task> task_;
+  std::array<VarIndex, 4> inputs_{};
+  std::size_t n_inputs_ = 0;
+  std::array<double, 6> values_{0.1, 0.2, 0.3, 0.4, 0.5, 0.6};
+  std::int64_t release_ = 0;
+};
+
+void BM_ProducerWrites(benchmark::State& state) {
+  PidFixture f("bench_null_pid");
+  for (auto _ : state) {
+    f.write_inputs();
+    benchmark::ClobberMemory();
+  }
+}
+
+void BM_PidCycleFramework(benchmark::State& state) {
+  PidFixture f("bench_null_pid");
+  for (auto _ : state) {
+    f.write_inputs();
+    f.cycle();
+    benchmark::ClobberMemory();
+  }
+}
+
+void BM_PidCycleReal(benchmark::State& state) {
+  PidFixture f("pid_joint");
+  for (auto _ : state) {
+    f.write_inputs();
+    f.cycle();
+    benchmark::ClobberMemory();
+  }
+}
+
+BENCHMARK(BM_ProducerWrites);
+BENCHMARK(BM_PidCycleFramework);
+BENCHMARK(BM_PidCycleReal);
+
+}  // namespace
+}  // namespace chimera::bench
+
+BENCHMARK_MAIN();

@@ -1,0 +1,130 @@
+"""The keys of bench/results/latest.json and the performance goals they are judged by.
+
+One table for bench/run.py (which keys exist) and bench/report.py (what they mean, which goal
+they serve). A key whose program has not been written yet is listed with `pending`; run.py
+leaves it absent from the JSON and the report says why.
+"""
+
+from dataclasses import dataclass, field
+from typing import Callable, Optional
+
+
+@dataclass
+class Key:
+    name: str
+    unit: str
+    what: str
+    pending: str = ""  # why it is not measured yet ("" = measured)
+
+
+KEYS = [
+    Key("svt_read_ns", "ns", "read of a 6-double state variable, uncontended (newer value, copied)"),
+    Key("svt_write_ns", "ns", "write of a 6-double state variable, uncontended"),
+    Key("mutex_read_ns", "ns", "the same 6 doubles copied out under a std::mutex"),
+    Key("mutex_write_ns", "ns", "the same 6 doubles copied in under a std::mutex"),
+] + [
+    Key(f"{kind}_{op}_{n}_ns", "ns", f"{op} of {n} double{'s' if n > 1 else ''}, {label}, uncontended")
+    for n in (1, 36, 1024)
+    for kind, label in (("svt", "state variable"), ("mutex", "std::mutex copy"))
+    for op in ("read", "write")
+] + [
+    Key("svt_read_p99_contended_ns", "ns", "reader p99, 6 doubles, writer hammering from the other core"),
+    Key("mutex_read_p99_contended_ns", "ns", "the same with a std::mutex"),
+    Key("svt_read_p50_contended_ns", "ns", "reader p50 under the same writer"),
+    Key("mutex_read_p50_contended_ns", "ns", "the same with a std::mutex"),
+    Key("svt_ipc_latency_ns_p50", "ns", "latest value to another process: Chimera's table, p50"),
+    Key("svt_ipc_latency_ns_p99", "ns", "the same, p99"),
+    Key("iceoryx_latency_ns_p50", "ns", "the same through iceoryx 2.0, p50"),
+    Key("iceoryx_latency_ns_p99", "ns", "the same through iceoryx 2.0, p99"),
+    Key("dds_latency_ns_p50", "ns", "the same through Cyclone DDS on loopback, p50"),
+    Key("dds_latency_ns_p99", "ns", "the same through Cyclone DDS on loopback, p99"),
+    Key("release_latency_ns_p50", "ns", "release latency of a 1 kHz Chimera task, p50"),
+    Key("release_latency_ns_p99", "ns", "release latency of a 1 kHz Chimera task, p99"),
+    Key("cyclictest_latency_ns_p50", "ns", "cyclictest alongside, same rate and priority, p50"),
+    Key("cyclictest_latency_ns_p99", "ns", "cyclictest alongside, p99"),
+    Key("release_latency_p50_ratio", "x", "Chimera p50 / cyclictest p50"),
+    Key("release_latency_p99_ratio", "x", "Chimera p99 / cyclictest p99"),
+    Key("cycle_overhead_ns", "ns", "framework cost per cycle of Figure 4's PID task (no kernel wake-up)"),
+    Key("switch_lost_cycles", "cycles", "lost cycles over 10,000 switches at 1 kHz",
+        pending="dynamic reconfiguration (`switch`) has not landed yet"),
+    Key("switch_commit_latency_ns_p99", "ns", "p99 of a switch's commit at a cycle boundary",
+        pending="dynamic reconfiguration (`switch`) has not landed yet"),
+    Key("tasks_1000_at_100hz_cpu_percent", "%", "framework CPU, 1,000 empty tasks at 100 Hz, share of 2 cores"),
+    Key("virtual_clock_speedup_fig4", "x", "simulated seconds per wall second, Figure 4 on the virtual clock"),
+]
+
+KEY_NAMES = [k.name for k in KEYS]
+
+
+@dataclass
+class Goal:
+    text: str                      # as DEVELOPERS.md / the guide states it
+    keys: list
+    check: Callable[[dict], Optional[bool]]  # None: cannot be judged (a key is absent)
+    measured: Callable[[dict], str]
+    notes: list = field(default_factory=list)
+
+
+def _have(r, *keys):
+    return all(k in r for k in keys)
+
+
+def _fmt(v, unit="ns"):
+    if unit == "ns":
+        if v >= 1e6:
+            return f"{v / 1e6:.2f} ms"
+        if v >= 1e4:
+            return f"{v / 1e3:.1f} µs"
+        if v >= 1e3:
+            return f"{v / 1e3:.2f} µs"
+        return f"{v:.1f} ns" if v < 100 else f"{v:.0f} ns"
+    if unit == "x":
+        return f"{v:.2f}x"
+    if unit == "%":
+        return f"{v:.1f} %"
+    return f"{v:g} {unit}"
+
+
+def _svt_uncontended(r):
+    if not _have(r, "svt_read_ns", "svt_write_ns", "mutex_read_ns", "mutex_write_ns"):
+        return None
+    return (r["svt_read_ns"] <= 10 and r["svt_write_ns"] <= 10 and r["svt_read_ns"] <= r["mutex_read_ns"] / 2
+            and r["svt_write_ns"] <= r["mutex_write_ns"] / 2)
+
+
+GOALS = [
+    Goal("state variable read or write of 6 doubles <= 10 ns uncontended, <= half a mutex-guarded copy",
+         ["svt_read_ns", "svt_write_ns", "mutex_read_ns", "mutex_write_ns"], _svt_uncontended,
+         lambda r: (f"read {_fmt(r['svt_read_ns'])} vs mutex {_fmt(r['mutex_read_ns'])} "
+                    f"({r['svt_read_ns'] / r['mutex_read_ns']:.2f}x); write {_fmt(r['svt_write_ns'])} vs mutex "
+                    f"{_fmt(r['mutex_write_ns'])} ({r['svt_write_ns'] / r['mutex_write_ns']:.2f}x)")),
+    Goal("reader p99 <= 100 ns while a writer hammers it from the other core",
+         ["svt_read_p99_contended_ns"],
+         lambda r: r["svt_read_p99_contended_ns"] <= 100 if _have(r, "svt_read_p99_contended_ns") else None,
+         lambda r: (f"{_fmt(r['svt_read_p99_contended_ns'])} (std::mutex: "
+                    f"{_fmt(r['mutex_read_p99_contended_ns'])})" if _have(r, "mutex_read_p99_contended_ns")
+                    else _fmt(r["svt_read_p99_contended_ns"]))),
+    Goal("framework overhead per task cycle (transfers and bookkeeping) <= 1 µs",
+         ["cycle_overhead_ns"],
+         lambda r: r["cycle_overhead_ns"] <= 1000 if _have(r, "cycle_overhead_ns") else None,
+         lambda r: _fmt(r["cycle_overhead_ns"])),
+    Goal("periodic release latency p50 and p99 within 1.1x of cyclictest run alongside",
+         ["release_latency_p50_ratio", "release_latency_p99_ratio"],
+         lambda r: (r["release_latency_p50_ratio"] <= 1.1 and r["release_latency_p99_ratio"] <= 1.1)
+         if _have(r, "release_latency_p50_ratio", "release_latency_p99_ratio") else None,
+         lambda r: (f"p50 {_fmt(r['release_latency_ns_p50'])} vs {_fmt(r['cyclictest_latency_ns_p50'])} "
+                    f"({r['release_latency_p50_ratio']:.2f}x); p99 {_fmt(r['release_latency_ns_p99'])} vs "
+                    f"{_fmt(r['cyclictest_latency_ns_p99'])} ({r['release_latency_p99_ratio']:.2f}x)")),
+    Goal("0 lost cycles over 10,000 reconfigurations at 1 kHz",
+         ["switch_lost_cycles"],
+         lambda r: r["switch_lost_cycles"] == 0 if _have(r, "switch_lost_cycles") else None,
+         lambda r: f"{r['switch_lost_cycles']:g} lost"),
+    Goal("1,000 tasks at 100 Hz on 2 cores with <= 10% framework CPU",
+         ["tasks_1000_at_100hz_cpu_percent"],
+         lambda r: r["tasks_1000_at_100hz_cpu_percent"] <= 10 if _have(r, "tasks_1000_at_100hz_cpu_percent") else None,
+         lambda r: _fmt(r["tasks_1000_at_100hz_cpu_percent"], "%")),
+    Goal("virtual-clock runs of Figure 4 at >= 100x real time",
+         ["virtual_clock_speedup_fig4"],
+         lambda r: r["virtual_clock_speedup_fig4"] >= 100 if _have(r, "virtual_clock_speedup_fig4") else None,
+         lambda r: _fmt(r["virtual_clock_speedup_fig4"], "x")),
+]

@@ -1,0 +1,323 @@
+#!/usr/bin/env python3
+"""Runs every benchmark of a build tree and writes bench/results/latest.json and latest.md.
+
+    bench/run.py BUILD_DIR [--quick] [--results DIR] [--only NAME,...]
+
+Each entry of PROGRAMS is one program and the keys it measures. A program writes a JSON
+fragment {"results": {key: number}, "details": {...}, "samples": {name: file}}; Google Benchmark
+programs are read through their own JSON. Fragments are merged in order; a program that is
+missing (a peer not installed) or fails leaves its keys absent, and the report says why.
+Adding a benchmark is one entry here, its keys in goals.py, and its program in CMakeLists.txt.
+"""
+
+import argparse
+import datetime
+import json
+import os
+import platform
+import re
+import shutil
+import statistics
+import subprocess
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable, Optional
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent
+sys.path.insert(0, str(HERE))
+import goals  # noqa: E402
+
+
+@dataclass
+class Program:
+    name: str
+    exe: str                                # in BUILD_DIR/bench, or a path below BUILD_DIR
+    what: str
+    keys: list
+    run: Optional[Callable] = None          # custom runner (build, ctx) -> fragment
+    args: list = field(default_factory=list)
+    timeout_s: int = 300
+
+
+# ---- Google Benchmark programs ----------------------------------------------------------------
+
+def run_gbench(exe, ctx, filter_re=None):
+    out = ctx.work / f"{Path(exe).name}.gbench.json"
+    cmd = [str(exe), f"--benchmark_out={out}", "--benchmark_out_format=json",
+           "--benchmark_format=console"]
+    if ctx.quick:
+        cmd += ["--benchmark_min_time=0.05"]
+    else:
+        # Five repetitions of 0.2 s; the median holds against the spikes of a shared machine.
+        cmd += ["--benchmark_min_time=0.2", "--benchmark_repetitions=5",
+                "--benchmark_report_aggregates_only=true"]
+    if filter_re:
+        cmd.append(f"--benchmark_filter={filter_re}")
+    ctx.log(" ".join(cmd))
+    subprocess.run(cmd, check=True, stdout=ctx.logfile, stderr=subprocess.STDOUT, timeout=600)
+    data = json.loads(out.read_text())
+    # CPU time, not wall time: these benchmarks are single-threaded, and CPU time leaves out the
+    # time this process spent preempted by others on a shared machine.
+    times = {}
+    for b in data["benchmarks"]:
+        name = b.get("run_name", b["name"])
+        if b.get("aggregate_name") not in (None, "median"):
+            continue
+        if b.get("aggregate_name") is None and b.get("run_type") == "aggregate":
+            continue
+        times[name] = b["cpu_time"] * {"ns": 1, "us": 1e3, "ms": 1e6, "s": 1e9}[b["time_unit"]]
+    return times, data.get("context", {})
+
+
+def run_svt_bench(build, ctx):
+    times, context = run_gbench(build / "bench" / "svt_bench", ctx)
+    res = {}
+    for n in (1, 6, 36, 1024):
+        suffix = "" if n == 6 else f"_{n}"
+        for key, bm in (("svt_read", "BM_SvtReadNew"), ("svt_write", "BM_SvtWrite"),
+                        ("mutex_read", "BM_MutexRead"), ("mutex_write", "BM_MutexWrite")):
+            name = f"{bm}/{n}"
+            if name in times:
+                res[f"{key}{suffix}_ns"] = times[name]
+    details = {"gbench_cpu_time_ns": times, "library_build_type": context.get("library_build_type")}
+    return {"results": res, "details": details}
+
+
+def run_cycle_bench(build, ctx):
+    times, _ = run_gbench(build / "bench" / "cycle_bench", ctx)
+    res = {}
+    if "BM_PidCycleFramework" in times and "BM_ProducerWrites" in times:
+        res["cycle_overhead_ns"] = times["BM_PidCycleFramework"] - times["BM_ProducerWrites"]
+    details = {"gbench_cpu_time_ns": times}
+    if "BM_PidCycleReal" in times and "BM_ProducerWrites" in times:
+        details["pid_joint_cycle_with_framework_ns"] = times["BM_PidCycleReal"] - times["BM_ProducerWrites"]
+    return {"results": res, "details": details}
+
+
+# ---- fragment programs ----------------------------------------------------------------------
+
+def run_fragment(exe, ctx, extra=(), timeout_s=300):
+    out = ctx.work / f"{Path(exe).name}.json"
+    cmd = [str(exe), "--out", str(out), "--samples-dir", str(ctx.work)] + (["--quick"] if ctx.quick else []) \
+        + list(extra)
+    ctx.log(" ".join(cmd))
+    proc = subprocess.run(cmd, stdout=ctx.logfile, stderr=subprocess.STDOUT, timeout=timeout_s)
+    frag = json.loads(out.read_text()) if out.exists() else {}
+    if proc.returncode != 0:
+        frag.setdefault("details", {})["error"] = f"exit {proc.returncode} (see {ctx.logpath})"
+    return frag
+
+
+# ---- the virtual clock ----------------------------------------------------------------------
+
+def run_virtual_clock(build, ctx):
+    chimera = build / "apps" / "chimera" / "chimera"
+    fig4 = ROOT / "examples" / "fig4_pid_joint.yaml"
+    sim_s = 10 if ctx.quick else 60
+    reps = 3
+
+    def wall(seconds):
+        cmd = [str(chimera), "run", str(fig4), "--clock", "virtual", "--for", f"{seconds}s"]
+        t0 = time.perf_counter()
+        subprocess.run(cmd, check=True, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                       stderr=ctx.logfile, timeout=600)
+        return time.perf_counter() - t0
+
+    ctx.log(f"{chimera} run {fig4} --clock virtual --for {sim_s}s  (x{reps}, and --for 1s)")
+    long_runs = [wall(sim_s) for _ in range(reps)]
+    short_runs = [wall(1) for _ in range(reps)]
+    t_long = statistics.median(long_runs)
+    t_short = statistics.median(short_runs)
+    details = {"simulated_s": sim_s, "wall_s_runs": long_runs, "wall_s_1s_runs": short_runs,
+               "command": f"chimera run examples/fig4_pid_joint.yaml --clock virtual --for {sim_s}s"}
+    if t_long > t_short:
+        details["steady_state_speedup"] = (sim_s - 1) / (t_long - t_short)
+    return {"results": {"virtual_clock_speedup_fig4": sim_s / t_long}, "details": details}
+
+
+PROGRAMS = [
+    Program("svt_uncontended", "svt_bench", "state variable vs std::mutex, uncontended (Google Benchmark)",
+            [k.name for k in goals.KEYS if re.match(r"(svt|mutex)_(read|write)(_\d+)?_ns$", k.name)],
+            run=run_svt_bench),
+    Program("svt_contended", "svt_contended", "reader latency under a hammering writer",
+            ["svt_read_p99_contended_ns", "mutex_read_p99_contended_ns",
+             "svt_read_p50_contended_ns", "mutex_read_p50_contended_ns"]),
+    Program("cycle_overhead", "cycle_bench", "framework cost per cycle of the PID task (Google Benchmark)",
+            ["cycle_overhead_ns"], run=run_cycle_bench),
+    Program("svt_ipc", "svt_ipc", "latest value between processes: Chimera's table",
+            ["svt_ipc_latency_ns_p50", "svt_ipc_latency_ns_p99"]),
+    Program("iceoryx_ipc", "iceoryx_ipc", "latest value between processes: iceoryx",
+            ["iceoryx_latency_ns_p50", "iceoryx_latency_ns_p99"]),
+    Program("dds_ipc", "dds_ipc", "latest value between processes: Cyclone DDS",
+            ["dds_latency_ns_p50", "dds_latency_ns_p99"]),
+    Program("release_latency", "release_latency", "release latency vs cyclictest",
+            ["release_latency_ns_p50", "release_latency_ns_p99", "cyclictest_latency_ns_p50",
+             "cyclictest_latency_ns_p99", "release_latency_p50_ratio", "release_latency_p99_ratio"]),
+    Program("many_tasks", "many_tasks", "1,000 tasks at 100 Hz", ["tasks_1000_at_100hz_cpu_percent"]),
+    Program("virtual_clock", "apps/chimera/chimera", "Figure 4 on the virtual clock",
+            ["virtual_clock_speedup_fig4"], run=run_virtual_clock),
+    # Dynamic reconfiguration: add Program("switch", "switch_bench", ..., ["switch_lost_cycles",
+    # "switch_commit_latency_ns_p99"]) once `switch` has landed, and drop `pending` in goals.py.
+]
+
+
+# ---- the machine ------------------------------------------------------------------------------
+
+def read(path, default=""):
+    try:
+        return Path(path).read_text().strip()
+    except OSError:
+        return default
+
+
+def cpu_times():
+    # /proc/stat "cpu" line: user nice system idle iowait irq softirq steal ...
+    fields = read("/proc/stat").splitlines()[0].split()[1:]
+    return [int(x) for x in fields]
+
+
+def sched_fifo_granted():
+    chrt = shutil.which("chrt")
+    if chrt is None:
+        return None
+    return subprocess.run([chrt, "-f", "10", "true"], capture_output=True).returncode == 0
+
+
+def machine_before():
+    cpuinfo = read("/proc/cpuinfo")
+    model = re.search(r"^model name\s*:\s*(.*)$", cpuinfo, re.M)
+    mem = re.search(r"^MemTotal:\s*(\d+) kB", read("/proc/meminfo"), re.M)
+    uname = platform.uname()
+    return {
+        "cpu_model": model.group(1) if model else platform.processor(),
+        "cpus_online": os.cpu_count(),
+        "cpus_usable": len(os.sched_getaffinity(0)),
+        "hypervisor": "yes" if re.search(r"^flags\s*:.*\bhypervisor\b", cpuinfo, re.M) else "no",
+        "memory_gib": round(int(mem.group(1)) / 2**20, 1) if mem else None,
+        "kernel": f"{uname.system} {uname.release} {uname.version}",
+        "clocksource": read("/sys/devices/system/clocksource/clocksource0/current_clocksource"),
+        "sched_fifo_granted": sched_fifo_granted(),
+        "sched_rt_runtime_us": read("/proc/sys/kernel/sched_rt_runtime_us"),
+        "load_average_before": list(os.getloadavg()),
+    }
+
+
+def machine_after(m, t0_cpu, wall_s):
+    t1 = cpu_times()
+    delta = [b - a for a, b in zip(t0_cpu, t1)]
+    total = sum(delta) or 1
+    idle = delta[3] + delta[4]
+    m["load_average_after"] = list(os.getloadavg())
+    m["cpu_busy_percent_during_run"] = round(100.0 * (total - idle) / total, 1)
+    m["steal_percent_during_run"] = round(100.0 * delta[7] / total, 2) if len(delta) > 7 else None
+    m["run_wall_s"] = round(wall_s, 1)
+    return m
+
+
+def git_commit():
+    try:
+        rev = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True,
+                             text=True, check=True).stdout.strip()
+        dirty = subprocess.run(["git", "-C", str(ROOT), "status", "--porcelain", "--", "src", "include", "bench"],
+                               capture_output=True, text=True).stdout.strip()
+        return rev + ("+changes" if dirty else "")
+    except (OSError, subprocess.CalledProcessError):
+        return None
+
+
+# ---- driver -------------------------------------------------------------------------------------
+
+class Context:
+    def __init__(self, quick, work):
+        self.quick = quick
+        self.work = work
+        self.logpath = work / "run.log"
+        self.logfile = open(self.logpath, "w")
+
+    def log(self, text):
+        self.logfile.write(f"$ {text}\n")
+        self.logfile.flush()
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("build", type=Path)
+    ap.add_argument("--quick", action="store_true", help="short runs (make bench-quick)")
+    ap.add_argument("--results", type=Path, default=None,
+                    help="where latest.json/.md go (default: bench/results, or BUILD/bench-results/quick "
+                         "for --quick, so that a quick run never replaces the committed full report)")
+    ap.add_argument("--only", default="", help="comma-separated program names")
+    opts = ap.parse_args()
+
+    build = opts.build.resolve()
+    work = build / "bench-results"  # samples and raw outputs; only the report goes to results/
+    work.mkdir(parents=True, exist_ok=True)
+    ctx = Context(opts.quick, work)
+    only = {n for n in opts.only.split(",") if n}
+
+    machine = machine_before()
+    t0_cpu = cpu_times()
+    t0 = time.monotonic()
+    merged = {"results": {}, "details": {}, "samples": {}, "absent": {}}
+    for p in PROGRAMS:
+        if only and p.name not in only:
+            continue
+        exe = build / "bench" / p.exe if "/" not in p.exe else build / p.exe
+        print(f"bench: {p.name:<16} {p.what}", flush=True)
+        started = time.monotonic()
+        if not exe.exists():
+            reason = f"{exe.relative_to(build)} was not built (a package of `scripts/setup.sh bench` is missing?)"
+            for k in p.keys:
+                merged["absent"][k] = reason
+            print(f"bench: {p.name:<16} skipped: {reason}", flush=True)
+            continue
+        try:
+            frag = p.run(build, ctx) if p.run else run_fragment(exe, ctx, p.args, p.timeout_s)
+        except (subprocess.SubprocessError, OSError, ValueError, KeyError) as e:
+            frag = {"details": {"error": f"{type(e).__name__}: {e} (see {ctx.logpath})"}}
+        frag.setdefault("details", {})["seconds"] = round(time.monotonic() - started, 1)
+        merged["results"].update(frag.get("results", {}))
+        merged["details"][p.name] = frag.get("details", {})
+        merged["samples"].update(frag.get("samples", {}))
+        for k in p.keys:
+            if k not in merged["results"]:
+                merged["absent"][k] = frag["details"].get("error", "the program did not report it")
+        status = frag["details"].get("error", "ok")
+        print(f"bench: {p.name:<16} {frag['details']['seconds']:.0f} s, {status}", flush=True)
+    for k in goals.KEYS:
+        if k.pending and k.name not in merged["results"]:
+            merged["absent"][k.name] = k.pending
+
+    doc = {
+        "schema": 1,
+        "mode": "quick" if opts.quick else "full",
+        "date": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
+        "commit": git_commit(),
+        "machine": machine_after(machine, t0_cpu, time.monotonic() - t0),
+    }
+    # The issue's keys at the top level, in the table's order; nothing invented for absent ones.
+    for k in goals.KEY_NAMES:
+        if k in merged["results"]:
+            doc[k] = round(merged["results"][k], 4)
+    extra = {k: v for k, v in merged["results"].items() if k not in goals.KEY_NAMES}
+    doc["absent"] = merged["absent"]
+    doc["other_figures"] = extra
+    doc["details"] = merged["details"]
+
+    results = opts.results or (work / "quick" if opts.quick or only else HERE / "results")
+    results.mkdir(parents=True, exist_ok=True)
+    name = "latest"
+    json_path = results / f"{name}.json"
+    json_path.write_text(json.dumps(doc, indent=2) + "\n")
+    import report  # noqa: E402  (needs matplotlib; imported late so that a JSON is written anyway)
+    md_path = report.write_report(doc, merged["samples"], results, name)
+    print(f"bench: wrote {json_path.relative_to(ROOT) if json_path.is_relative_to(ROOT) else json_path} and "
+          f"{md_path.relative_to(ROOT) if md_path.is_relative_to(ROOT) else md_path} "
+          f"in {time.monotonic() - t0:.0f} s")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,83 @@
+// cpu_load: a task that only takes time. For what-if studies and schedulability experiments on
+// either clock, for benchmarks (many trivial tasks), and for injecting timing failures.
+
+#include <cmath>
+#include <cstdint>
+
+#include "chimera/exec/clock.hpp"
+#include "chimera/module/registry.hpp"
+
+namespace chimera::modules {
+namespace {
+
+std::int64_t ns_of(double seconds) { return static_cast<std::int64_t>(std::llround(seconds * 1e9)); }
+
+class CpuLoad final : public Module {
+ public:
+  static constexpr const char* kName = "cpu_load";
+  static constexpr const char* kSummary = "Takes a set execution time each cycle; can overrun on purpose";
+  static constexpr const char* kDoc =
+      "A task that only takes time: each cycle lasts `exec` seconds, and every `overrun_every`-th "
+      "cycle lasts `overrun` seconds longer. On the real clock it busy-waits on the monotonic clock "
+      "(real CPU time, so the scheduler sees real load); on the virtual clock it charges the time as "
+      "simulated execution (Module::consume_virtual_time), so runs repeat exactly. With a `wcet` on "
+      "its task, the overruns are timing failures the framework detects; `recover` makes its "
+      "error() recover from timing failures (otherwise a hard task goes to ERROR at the first). "
+      "Parameters: exec (s, default 0), overrun_every (cycles, default 0: never), overrun (s, "
+      "default 0), recover (default false). No ports. See docs/modules/cpu_load.md.";
+
+  static void declare(Declarations& d, const Params&) {
+    d.param("exec", 0.0, "s", "execution time of each cycle");
+    d.param("overrun_every", 0.0, "cycles", "every this many cycles one lasts longer (0: never)");
+    d.param("overrun", 0.0, "s", "how much longer that cycle lasts");
+    d.param("recover", false, "", "error() recovers from timing failures");
+  }
+
+ protected:
+  Status init(InitContext& ctx) override {
+    const Params& p = ctx.params();
+    const double exec = p.number("exec");
+    const double every = p.number("overrun_every");
+    const double overrun = p.number("overrun");
+    if (!(exec >= 0.0) || !(overrun >= 0.0)) return Status::fail("cpu_load: exec and overrun must be >= 0 s");
+    if (!(every >= 0.0) || every != std::floor(every))
+      return Status::fail("cpu_load: overrun_every must be a whole number of cycles >= 0");
+    exec_ns_ = ns_of(exec);
+    overrun_ns_ = ns_of(overrun);
+    every_ = static_cast<std::uint64_t>(every);
+    recover_ = p.flag("recover");
+    timing_ = &ctx.timing();
+    return Status::ok();
+  }
+
+  Status cycle() override {
+    ++cycles_;
+    const std::int64_t t = exec_ns_ + (every_ != 0 && cycles_ % every_ == 0 ? overrun_ns_ : 0);
+    if (timing_->virtual_clock) {
+      consume_virtual_time(t);
+    } else {
+      const std::int64_t until = monotonic_ns() + t;
+      while (monotonic_ns() < until) {
+      }
+    }
+    return Status::ok();
+  }
+
+  Status error() override {
+    const bool timing = timing_->fault == Fault::kDeadlineMissed || timing_->fault == Fault::kBudgetOverrun;
+    return recover_ && timing ? Status::ok() : Status::fail("cpu_load: a timing failure, not recovered");
+  }
+
+ private:
+  const CycleTiming* timing_ = nullptr;
+  std::int64_t exec_ns_ = 0;
+  std::int64_t overrun_ns_ = 0;
+  std::uint64_t every_ = 0;
+  std::uint64_t cycles_ = 0;
+  bool recover_ = false;
+};
+
+CHIMERA_REGISTER_MODULE(CpuLoad);
+
+}  // namespace
+}  // namespace chimera::modules

@@ -1,0 +1,150 @@
+// udp_command: an aperiodic task whose resource port is a UDP socket. Each datagram is one event:
+// the framework wakes the task when the socket is readable, sync() takes one datagram, cycle()
+// publishes the numbers it holds. Run it under a sporadic server (`server:` in the file) so that
+// a flood of datagrams can never take more than its share of the processor.
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <array>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <string>
+
+#include "chimera/module/registry.hpp"
+
+namespace chimera::modules {
+namespace {
+
+constexpr double kDefaultSize = 6;
+constexpr int kMaxSize = 256;
+
+std::uint32_t size_of(const Params& p) {
+  const double n = p.number("size", kDefaultSize);
+  if (!(n >= 1) || n > kMaxSize) return static_cast<std::uint32_t>(kDefaultSize);
+  return static_cast<std::uint32_t>(std::lround(n));
+}
+
+class UdpCommand final : public Module {
+ public:
+  static constexpr const char* kName = "udp_command";
+  static constexpr const char* kSummary = "Aperiodic UDP command receiver: each datagram of numbers becomes a variable";
+  static constexpr const char* kDoc =
+      "An aperiodic task (give it no period, and a `server:` to bound its share of the processor) "
+      "whose resource port is a UDP socket bound to address:port. Each datagram is one event: when "
+      "the socket is readable the framework calls sync(), which takes one datagram without "
+      "blocking, then cycle(), which parses it as `size` numbers separated by blanks (text, e.g. "
+      "\"0.5 0 0.3 0 0 0\") and publishes them on out-var `command`; a datagram that is not exactly "
+      "`size` numbers is counted as rejected and changes nothing. Out-vars: command[size], "
+      "command_stats[2] = [datagrams accepted, datagrams rejected], udp_port[1] = the port bound "
+      "(useful with port 0, which lets the system choose). Parameters: address (default "
+      "\"127.0.0.1\"), port (default 0), size (default 6, at most 256), cost (s, default 0: "
+      "simulated time each datagram takes on the virtual clock). See docs/modules/udp_command.md.";
+
+  static void declare(Declarations& d, const Params& p) {
+    const std::uint32_t n = size_of(p);
+    d.out_var("command", Dim::fixed(n), "the numbers of the last accepted datagram");
+    d.out_var("command_stats", Dim::fixed(2), "[datagrams accepted, datagrams rejected]");
+    d.out_var("udp_port", Dim::fixed(1), "the UDP port the socket is bound to");
+    d.param("address", std::string("127.0.0.1"), "", "IPv4 address to bind");
+    d.param("port", 0.0, "", "UDP port to bind (0: the system chooses; see udp_port)");
+    d.param("size", kDefaultSize, "", "numbers per datagram");
+    d.param("cost", 0.0, "s", "simulated execution time per datagram on the virtual clock");
+    d.resource("a UDP socket: each datagram is one event");
+  }
+
+ protected:
+  Status init(InitContext& ctx) override {
+    const Params& p = ctx.params();
+    const double port = p.number("port");
+    if (!(port >= 0 && port <= 65535) || port != std::floor(port))
+      return Status::fail("udp_command: port must be a whole number from 0 to 65535");
+    const double size = p.number("size", kDefaultSize);
+    if (!(size >= 1 && size <= kMaxSize) || size != std::floor(size))
+      return Status::fail("udp_command: size must be a whole number from 1 to 256");
+    const double cost = p.number("cost");
+    if (!(cost >= 0)) return Status::fail("udp_command: cost must be >= 0 s");
+    cost_ns_ = static_cast<std::int64_t>(std::llround(cost * 1e9));
+
+    sockaddr_in addr{};
+    addr.sin_family = AF_INET;
+    addr.sin_port = htons(static_cast<std::uint16_t>(port));
+    if (::inet_pton(AF_INET, p.text("address", "127.0.0.1").c_str(), &addr.sin_addr) != 1)
+      return Status::fail("udp_command: address is not an IPv4 address");
+    fd_ = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+    if (fd_ < 0) return Status::fail("udp_command: cannot create a UDP socket");
+    if (::bind(fd_, reinterpret_cast<const sockaddr*>(&addr), sizeof(addr)) != 0)  // NOLINT: the sockets API
+      return Status::fail("udp_command: cannot bind the socket (address in use?)");
+    socklen_t len = sizeof(addr);
+    ::getsockname(fd_, reinterpret_cast<sockaddr*>(&addr), &len);  // NOLINT: the sockets API
+
+    command_ = ctx.out<double>("command");
+    stats_ = ctx.out<double>("command_stats");
+    udp_port_ = ctx.out<double>("udp_port");
+    if (ctx.failed()) return Status::ok();
+    udp_port_[0] = ntohs(addr.sin_port);
+    timing_ = &ctx.timing();
+    ctx.trigger_on_fd(fd_);
+    return Status::ok();
+  }
+
+  // One datagram per event: the socket stays readable while more wait, so the next one is
+  // another event, which the server's budget may defer.
+  Status sync() override {
+    const ssize_t n = ::recv(fd_, buffer_.data(), buffer_.size() - 1, 0);
+    length_ = n > 0 ? static_cast<std::size_t>(n) : 0;
+    return Status::ok();
+  }
+
+  Status cycle() override {
+    if (timing_->virtual_clock) consume_virtual_time(cost_ns_);
+    if (length_ == 0) return Status::ok();
+    std::array<double, kMaxSize> values{};
+    std::size_t count = 0;
+    const char* p = buffer_.data();
+    const char* end = p + length_;
+    bool good = true;
+    while (good) {
+      while (p < end && (*p == ' ' || *p == '\t' || *p == '\n' || *p == '\r' || *p == ',')) ++p;
+      if (p == end) break;
+      double v = 0;
+      const auto [next, ec] = std::from_chars(p, end, v);
+      good = ec == std::errc{} && std::isfinite(v) && count < command_.size();
+      if (good) values[count++] = v;
+      p = next;
+    }
+    length_ = 0;
+    if (!good || count != command_.size()) {
+      stats_[1] += 1;
+      return Status::ok();
+    }
+    for (std::size_t i = 0; i < count; ++i) command_[i] = values[i];
+    stats_[0] += 1;
+    return Status::ok();
+  }
+
+  Status kill() override {
+    if (fd_ >= 0) ::close(fd_);
+    fd_ = -1;
+    return Status::ok();
+  }
+
+ private:
+  int fd_ = -1;
+  std::int64_t cost_ns_ = 0;
+  const CycleTiming* timing_ = nullptr;
+  std::array<char, 4096> buffer_{};
+  std::size_t length_ = 0;
+  Out<double> command_;
+  Out<double> stats_;
+  Out<double> udp_port_;
+};
+
+CHIMERA_REGISTER_MODULE(UdpCommand);
+
+}  // namespace
+}  // namespace chimera::modules

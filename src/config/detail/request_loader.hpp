@@ -1,0 +1,17 @@
+#pragma once
+// Reading the subsystem file's `requests:` list: the switches that tasks may ask for. Private to
+// src/config.
+
+#include <optional>
+
+#include "chimera/config/subsystem.hpp"
+#include "chimera/core/result.hpp"
+#include "config/detail/yaml_reader.hpp"
+
+namespace chimera::config_detail {
+
+/// Reads `requests:` (absent: none allowed) into spec.requests. Configurations and tasks must
+/// already be read: every name is checked against them.
+Result<void> read_requests(const Source& source, const std::optional<Field>& field, SubsystemSpec& spec);
+
+}  // namespace chimera::config_detail

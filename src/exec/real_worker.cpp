@@ -1,0 +1,299 @@
+#include "real_worker.hpp"
+
+#include <poll.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstring>
+#include <optional>
+
+#include "chimera/exec/clock.hpp"
+#include "futex.hpp"
+#include "priority_dispatcher.hpp"
+#include "real_executive.hpp"
+
+namespace chimera {
+
+namespace {
+// Release indices are compared modulo 2^32 (the futex word is 32 bits).
+bool reached(std::uint32_t completed_plus_one, std::int64_t k) {
+  return static_cast<std::int32_t>(completed_plus_one - static_cast<std::uint32_t>(k + 1)) >= 0;
+}
+
+void set_own_priority(Worker& w, int priority) noexcept {
+  if (w.current_priority.load(std::memory_order_relaxed) == priority) return;
+  sched_param sp{};
+  sp.sched_priority = priority;
+  if (pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp) == 0)
+    w.current_priority.store(priority, std::memory_order_relaxed);  // see PriorityDispatcher::rerank
+}
+}  // namespace
+
+Worker::~Worker() {
+  if (bell_fd >= 0) ::close(bell_fd);
+}
+
+void ring_bell(const Worker& w) noexcept {
+  if (w.bell_fd < 0) return;
+  const std::uint64_t one = 1;
+  (void)!::write(w.bell_fd, &one, sizeof(one));  // an eventfd counter: a full one still wakes
+}
+
+void Worker::main() {
+  self.store(pthread_self(), std::memory_order_relaxed);  // published by job_active's release store
+  // Touch the stack once so that its pages are resident before the first cycle.
+  std::array<char, std::size_t{64} * 1024> prefault;  // NOLINT(cppcoreguidelines-pro-type-member-init): written next
+  std::memset(prefault.data(), 0, prefault.size());
+  asm volatile("" : : "r"(prefault.data()) : "memory");  // keeps the compiler from dropping the writes
+
+  std::uint32_t seen = 0;
+  std::int64_t k = 0;
+  for (;;) {
+    const std::uint32_t req = request_seq.load(std::memory_order_acquire);  // acquire: see `mail`
+    if (req != seen) {
+      seen = req;
+      if (!handle(req, k)) return;
+      continue;
+    }
+    if (task->state() != TaskState::kOn) {
+      scheduled.store(-1, std::memory_order_release);  // release: successors stop waiting on us
+      if (bell_fd >= 0) {
+        pollfd p{bell_fd, POLLIN, 0};
+        (void)::poll(&p, 1, -1);
+        std::uint64_t drained = 0;
+        (void)!::read(bell_fd, &drained, sizeof(drained));
+      } else {
+        detail::futex_wait(request_seq, req, -1);
+      }
+      continue;
+    }
+    if (task->periodic())
+      run_periodic(req, k);
+    else
+      run_aperiodic(req);
+  }
+}
+
+void Worker::reply_to(std::uint32_t seq) {
+  done_seq.store(seq, std::memory_order_release);  // release: publishes `reply`
+  detail::futex_wake_all(done_seq);
+}
+
+bool Worker::handle(std::uint32_t seq, std::int64_t& k) {
+  const std::int64_t now = exec->now_ns();
+  const TaskState before = task->state();
+  switch (mail.kind) {
+    case MailKind::kJoin:
+      // The control thread has already published `scheduled` for every task of the group.
+      k = mail.at;
+      held = false;
+      reply = Result<void>{};
+      reply_to(seq);
+      return true;
+    case MailKind::kLeaveAt:
+      leave_at = mail.at;
+      leave_seq = seq;
+      // Not released and nothing to finish: an aperiodic task, or one already past its last
+      // release before the switch, leaves at once; otherwise after its current job (the loop).
+      if (!task->periodic() || task->state() != TaskState::kOn || exec->epoch_ns() + k * task->period_ns() >= leave_at)
+        leave();
+      return task->state() != TaskState::kNotCreated;
+    case MailKind::kReinit:
+      reply = task->reinit(now)
+                  ? Result<void>{}
+                  : make_error(Errc::kModuleFault, task->name() + ": reinit failed; the task is no longer ON");
+      reply_to(seq);
+      return task->state() != TaskState::kNotCreated;
+    case MailKind::kSignal:
+    case MailKind::kOnHeld: break;
+  }
+  const Signal request = mail.kind == MailKind::kOnHeld ? Signal::kOn : mail.signal;
+  // A task turning on joins the grid at the next whole multiple of its period. Successors must
+  // see that release as scheduled as soon as they can see the task ON, or one of them could run
+  // its shared release without waiting for it: publish it before the state changes. (A held
+  // task's release is published by the control thread before kJoin.)
+  const std::int64_t join = task->periodic() ? (now + task->period_ns() - 1) / task->period_ns() : -1;
+  const bool turning_on = before != TaskState::kOn && request == Signal::kOn;
+  if (turning_on && task->periodic() && mail.kind == MailKind::kSignal)
+    scheduled.store(join, std::memory_order_release);  // release: pairs with successors' acquire load
+  reply = task->apply(request, now);
+  if (before != TaskState::kOn && task->state() == TaskState::kOn) {
+    if (task->periodic()) k = join;
+    held = mail.kind == MailKind::kOnHeld && task->periodic();
+    leave_at = -1;
+    on_turned_on();
+  }
+  const bool alive = task->state() != TaskState::kNotCreated;
+  reply_to(seq);
+  return alive;
+}
+
+void Worker::leave() {
+  const std::uint32_t seq = leave_seq;
+  leave_at = -1;
+  leave_seq = 0;
+  reply = task->state() == TaskState::kOn ? task->apply(Signal::kOff, exec->now_ns()) : Result<void>{};
+  held = false;
+  reply_to(seq);
+}
+
+void Worker::on_turned_on() noexcept {
+  int var = -1;
+  const std::string& port = task->trigger().update_port;
+  if (!port.empty()) {
+    for (const auto& b : task->resolved().bindings)
+      if (b.port == port)
+        if (auto v = exec->table().find(b.variable)) var = static_cast<int>(*v);
+  }
+  trigger_var.store(var, std::memory_order_relaxed);  // producers read it on its own
+  update_pending.store(false, std::memory_order_relaxed);
+  if (task->spec().server && refill_count == 0 && budget_ns <= 0) budget_ns = task->spec().server->budget_ns;
+}
+
+void Worker::publish_job(std::int64_t release_abs) {
+  const std::int64_t release = release_abs - exec->epoch_ns();
+  job_release_ns.store(release, std::memory_order_relaxed);
+  job_deadline_ns.store(task->absolute_deadline(release), std::memory_order_relaxed);
+  job_active.store(true, std::memory_order_release);  // release: the dispatcher sees the two above
+  dispatcher->poke();  // on this CPU the dispatcher preempts us here and sets our priority
+}
+
+std::int64_t Worker::run_job(std::int64_t release_abs) {
+  const std::int64_t epoch = exec->epoch_ns();
+  const std::int64_t start = monotonic_ns();
+  (void)task->begin_job(release_abs - epoch, start - epoch);
+  const std::int64_t used = task->end_job(monotonic_ns() - epoch, -1);
+  for (Worker* s : subscribers) {
+    const int v = s->trigger_var.load(std::memory_order_relaxed);  // a hint; the flag below orders
+    if (v < 0 || std::find(out_vars.begin(), out_vars.end(), v) == out_vars.end()) continue;
+    // acq_rel: our published values happen before the subscriber's cycle that clears the flag
+    if (!s->update_pending.exchange(true, std::memory_order_acq_rel)) ring_bell(*s);
+  }
+  if (dispatcher != nullptr) {
+    job_active.store(false, std::memory_order_relaxed);               // the dispatcher only ranks; order is not needed
+    set_own_priority(*this, PriorityDispatcher::kReleasingPriority);  // wake up able to ask for a rank
+  }
+  return used;
+}
+
+void Worker::run_periodic(std::uint32_t req, std::int64_t& k) {
+  if (held) {  // waiting for kJoin; `scheduled` is the control thread's until then
+    detail::futex_wait(request_seq, req, -1);
+    return;
+  }
+  const std::int64_t period = task->period_ns();
+  const std::int64_t epoch = exec->epoch_ns();
+  std::int64_t release_abs = epoch + k * period;
+  if (leave_seq != 0 && release_abs >= leave_at) {
+    leave();  // a switch: this task's last release came before the commit
+    return;
+  }
+  scheduled.store(k, std::memory_order_release);  // release: pairs with successors' acquire load
+  const std::int64_t now = monotonic_ns();
+  if (now < release_abs) {
+    detail::futex_wait(request_seq, req, release_abs);
+    return;  // a signal, a spurious wake, or the release: the loop tells which
+  }
+  if (task->spec().late == LatePolicy::kSkip) {
+    // Releases whose deadline has already passed are not worth starting: skip them.
+    std::uint64_t skipped = 0;
+    while (task->absolute_deadline(release_abs - epoch) < now - epoch) {
+      ++k;
+      ++skipped;
+      release_abs += period;
+    }
+    if (skipped != 0) {
+      task->skip_releases(skipped, now - epoch);
+      scheduled.store(k, std::memory_order_release);  // release: as above
+      if (task->state() != TaskState::kOn || now < release_abs) return;
+    }
+  }
+  if (dispatcher != nullptr) publish_job(release_abs);
+  wait_for_predecessors(k, release_abs);
+  (void)run_job(release_abs);
+  // seq_cst store, then seq_cst load of `waiters`: with the successor's seq_cst increment and
+  // re-check this is Dekker's pattern, so either it sees our store or we see it waiting.
+  completed.store(static_cast<std::uint32_t>(k + 1), std::memory_order_seq_cst);
+  if (waiters.load(std::memory_order_seq_cst) != 0) detail::futex_wake_all(completed);
+  ++k;  // under late: run a late cycle runs late; the next release stays on the absolute grid
+}
+
+void Worker::refill(std::int64_t now_abs) noexcept {
+  while (refill_count > 0 && refills[refill_head].first <= now_abs) {
+    budget_ns += refills[refill_head].second;
+    refill_head = (refill_head + 1) % kMaxRefills;
+    --refill_count;
+  }
+}
+
+void Worker::run_aperiodic(std::uint32_t req) {
+  const std::optional<ServerSpec>& server = task->spec().server;
+  const std::int64_t now = monotonic_ns();
+  refill(now);
+  const bool exhausted = server && budget_ns <= 0;
+  const int fd = task->trigger().fd;
+  std::array<pollfd, 2> fds{pollfd{bell_fd, POLLIN, 0}, pollfd{fd, POLLIN, 0}};
+  if (exhausted || !update_pending.load(std::memory_order_acquire)) {  // acquire: pairs with the producer
+    // An exhausted server waits for its next refill, and does not watch the event source meanwhile.
+    const nfds_t n = (fd >= 0 && !exhausted) ? 2 : 1;
+    timespec rel{};
+    const timespec* timeout = nullptr;
+    if (exhausted && refill_count > 0) {
+      rel = to_timespec(std::max<std::int64_t>(0, refills[refill_head].first - now));
+      timeout = &rel;
+    }
+    (void)::ppoll(fds.data(), n, timeout, nullptr);
+    if ((fds[0].revents & POLLIN) != 0) {
+      std::uint64_t drained = 0;
+      (void)!::read(bell_fd, &drained, sizeof(drained));
+    }
+  }
+  if (request_seq.load(std::memory_order_acquire) != req) return;  // the mail first; acquire: as in main
+  if (exhausted || task->state() != TaskState::kOn) return;
+  const bool fd_event = fd >= 0 && (fds[1].revents & (POLLIN | POLLERR | POLLHUP)) != 0;
+  const bool update_event = update_pending.exchange(false, std::memory_order_acq_rel);  // acq_rel: see run_job
+  if (!fd_event && !update_event) return;
+
+  const std::int64_t release_abs = monotonic_ns();
+  if (dispatcher != nullptr) publish_job(release_abs);
+  const std::int64_t start = monotonic_ns();
+  const std::int64_t used = run_job(release_abs);
+  if (server) {
+    // Sporadic server: what a job used comes back one server period after the job started.
+    budget_ns -= used;
+    const auto refill_at = std::pair{start + server->period_ns, used};
+    if (refill_count < kMaxRefills) {
+      refills[(refill_head + refill_count) % kMaxRefills] = refill_at;
+      ++refill_count;
+    } else {
+      auto& last = refills[(refill_head + kMaxRefills - 1) % kMaxRefills];
+      last = {std::max(last.first, refill_at.first), last.second + used};  // merged, later: safe
+    }
+  }
+}
+
+void Worker::wait_for_predecessors(std::int64_t k, std::int64_t release_abs) const {
+  // Bounded: a predecessor that keeps us waiting more than half our deadline no longer holds us
+  // back. Counted from when the wait starts, so that the order still holds while tasks catch up
+  // after a stall (when every release is already in the past).
+  const std::int64_t give_up = std::max(release_abs, monotonic_ns()) + task->spec().deadline_ns / 2;
+  for (Worker* p : predecessors) {
+    for (;;) {
+      if (reached(p->completed.load(std::memory_order_acquire), k)) break;  // acquire: its cycle is done
+      if (p->task->state() != TaskState::kOn) break;
+      const std::int64_t s = p->scheduled.load(std::memory_order_acquire);  // acquire: pairs with its store
+      if (s < 0 || s > k) break;                           // not released, or joined after this instant
+      p->waiters.fetch_add(1, std::memory_order_seq_cst);  // seq_cst: Dekker with the producer (see run_periodic)
+      const std::uint32_t c = p->completed.load(std::memory_order_seq_cst);
+      bool in_time = true;
+      if (!reached(c, k)) in_time = detail::futex_wait(p->completed, c, give_up);
+      p->waiters.fetch_sub(1, std::memory_order_relaxed);  // only a hint for the producer's wake
+      if (!in_time && monotonic_ns() >= give_up) {
+        task->record_order_timeout();
+        return;  // past the bound: run with what the table holds
+      }
+    }
+  }
+}
+
+}  // namespace chimera

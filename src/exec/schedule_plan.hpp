@@ -1,0 +1,34 @@
+#pragma once
+// Where each task of a subsystem runs and how the file's policy ranks it: the CPU assignment
+// (pinned by `cpu:` or automatic) and, per configuration, each task's urgency data (MUF's
+// critical set among them). Computed off the real-time path, before start and at each switch.
+
+#include <string>
+#include <vector>
+
+#include "chimera/config/verify.hpp"
+#include "release_order.hpp"
+#include "urgency.hpp"
+
+namespace chimera {
+
+struct SchedulePlan {
+  SchedulerKind policy = SchedulerKind::kRm;
+  std::vector<int> cpu;              // per task of the file: the CPU it runs on
+  std::vector<TaskUrgency> urgency;  // per task of the file
+};
+
+/// The execution time analysis and assignment count for a task: its wcet, else its virtual_exec,
+/// else 0 (unknown).
+std::int64_t planned_cost_ns(const TaskSpec& task);
+
+/// Plans every task of the file on `cpus` (the CPUs the subsystem may use), with the critical
+/// set of MUF computed for the tasks of `configuration` (the others are planned as if alone).
+/// Not real-time safe.
+SchedulePlan make_schedule_plan(const ResolvedSubsystem& subsystem, const ReleaseOrder& order,
+                                const std::vector<int>& cpus, const std::vector<std::string>& configuration);
+
+/// The CPUs a subsystem may use: the file's `cpus`, or every online CPU.
+std::vector<int> subsystem_cpus(const SubsystemSpec& spec);
+
+}  // namespace chimera

@@ -1,0 +1,96 @@
+#pragma once
+// The inside of a Subsystem, shared by the files that implement its parts: creation and signals
+// (exec/subsystem.cpp) and dynamic reconfiguration (reconfig/switch.cpp).
+
+#include <cstring>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "chimera/exec/subsystem.hpp"
+#include "chimera/exec/task.hpp"
+#include "real_executive.hpp"
+#include "reconfig/request_board.hpp"
+#include "release_order.hpp"
+#include "schedule_plan.hpp"
+#include "virtual_executive.hpp"
+
+namespace chimera {
+
+namespace detail {
+class TableFlags final : public SubsystemFlags {
+ public:
+  explicit TableFlags(const GlobalTable* table) : table_(table) {}
+  [[nodiscard]] bool illegal_configuration() const noexcept override { return table_->illegal_configuration(); }
+
+ private:
+  const GlobalTable* table_;
+};
+
+}  // namespace detail
+
+struct Subsystem::Impl {
+  SubsystemSpec spec;
+  RunOptions options;
+  Resolution resolution;
+  std::string configuration;
+  std::unique_ptr<GlobalTable> table;
+  std::unique_ptr<detail::TableFlags> flags;
+  std::vector<std::unique_ptr<Task>> tasks;
+  ReleaseOrder order;
+  SchedulePlan plan;
+  std::unique_ptr<VirtualExecutive> virtual_exec;
+  std::unique_ptr<RealExecutive> real_exec;
+  std::vector<std::string> last_error;
+  std::vector<Event> pending;  // collected from the tasks' rings, not yet handed to a caller
+  std::mutex events_mutex;     // guards pending and last_error; never taken by a task's thread
+  std::int64_t stopped_at_ns = 0;
+  bool stopped = false;
+
+  // Dynamic reconfiguration (reconfig/switch.cpp).
+  std::unique_ptr<SubsystemRequestBoard> requests;
+  std::vector<int> served;  // per task: the request last dealt with (-1: none)
+  std::vector<SwitchRecord> history;
+  bool switching_flag = false;  // the flag is up for a switch that must create tasks
+  std::mutex ops_mutex;         // signals, switches and stop: from the shell or the request service
+  std::thread request_service;  // real clock: carries out the switches tasks ask for
+  std::atomic<bool> service_stop{false};
+
+  /// The illegal-configuration flag: up while a switch creates tasks, or while a task is in ERROR.
+  void update_flag() {
+    bool error = false;
+    for (const auto& t : tasks) error = error || t->state() == TaskState::kError;
+    table->set_illegal_configuration(switching_flag || error);
+  }
+
+  /// Moves every task's real-time events into `pending` and notes the last failure of each.
+  void collect_events() {
+    std::lock_guard<std::mutex> lock(events_mutex);
+    RtEvent e;
+    for (std::size_t i = 0; i < tasks.size(); ++i) {
+      while (tasks[i]->events().pop(e)) {
+        pending.push_back(Event{e.time_ns, tasks[i]->name(), e.text.data()});
+        if (std::strstr(e.text.data(), "ERROR") != nullptr || std::strstr(e.text.data(), "failed") != nullptr)
+          last_error[i] = e.text.data();
+      }
+    }
+  }
+
+  [[nodiscard]] std::int64_t now() const {
+    if (stopped) return stopped_at_ns;
+    return virtual_exec ? virtual_exec->now_ns() : real_exec->now_ns();
+  }
+  Result<void> signal(std::size_t i, Signal s) const {  // const: the executives are owned, not members' state
+    return virtual_exec ? virtual_exec->signal(i, s) : real_exec->signal(i, s);
+  }
+  std::optional<std::size_t> index_of(std::string_view name) const {
+    for (std::size_t i = 0; i < tasks.size(); ++i)
+      if (tasks[i]->name() == name) return i;
+    return std::nullopt;
+  }
+};
+
+}  // namespace chimera

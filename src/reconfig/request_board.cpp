@@ -1,0 +1,42 @@
+#include "request_board.hpp"
+
+#include "exec/futex.hpp"
+
+namespace chimera {
+
+SubsystemRequestBoard::SubsystemRequestBoard(std::vector<std::string> configurations, std::size_t tasks)
+    : configurations_(std::move(configurations)), slots_(std::make_unique<std::atomic<int>[]>(tasks)), tasks_(tasks) {
+  clear();
+}
+
+int SubsystemRequestBoard::configuration_index(std::string_view name) const {
+  for (std::size_t i = 0; i < configurations_.size(); ++i)
+    if (configurations_[i] == name) return static_cast<int>(i);
+  return -1;
+}
+
+void SubsystemRequestBoard::post(int task, int configuration) noexcept {
+  if (task < 0 || static_cast<std::size_t>(task) >= tasks_) return;
+  // acq_rel: what the task did before asking is seen by whoever serves the request. Asking again
+  // for the same thing costs one exchange and no system call.
+  if (slots_[static_cast<std::size_t>(task)].exchange(configuration, std::memory_order_acq_rel) == configuration)
+    return;
+  changes_.fetch_add(1, std::memory_order_release);  // release: pairs with the watchers' acquire
+  detail::futex_wake_all(changes_);
+}
+
+int SubsystemRequestBoard::asked(std::size_t task) const noexcept {
+  return slots_[task].load(std::memory_order_acquire);  // acquire: pairs with post()
+}
+
+void SubsystemRequestBoard::clear() noexcept {
+  for (std::size_t i = 0; i < tasks_; ++i)
+    slots_[i].store(-1, std::memory_order_relaxed);  // only hints until the next post
+}
+
+void SubsystemRequestBoard::wake() noexcept {
+  changes_.fetch_add(1, std::memory_order_release);  // release: the watcher re-reads its stop flag
+  detail::futex_wake_all(changes_);
+}
+
+}  // namespace chimera

@@ -1,0 +1,227 @@
+// Dynamic reconfiguration (paper 3.4; docs/reconfiguration.md): Subsystem::switch_to and the
+// service that carries out the switches tasks ask for. Two phases, as STYLE asks: prepare and
+// verify off the real-time path, where allocation and failure are allowed (plan, verify, create
+// the missing tasks while the current configuration runs on); then commit at one cycle boundary
+// in one step, which the executives carry out (leaving tasks off after their last release
+// before it, joining tasks on and released from it, the others untouched).
+
+#include <algorithm>
+#include <map>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "chimera/control/timing_table.hpp"
+#include "exec/subsystem_impl.hpp"
+#include "exec/value_codec.hpp"
+#include "switch_plan.hpp"
+
+namespace chimera {
+
+namespace {
+
+constexpr std::int64_t kCommitMarginNs = 200'000;  // real clock: time to post the commit before it
+
+std::vector<std::string> names_of(const std::vector<std::unique_ptr<Task>>& tasks, const std::vector<std::size_t>& is) {
+  std::vector<std::string> out;
+  out.reserve(is.size());
+  for (const std::size_t i : is) out.push_back(tasks[i]->name());
+  return out;
+}
+
+// The values of the variables in `names`, as doubles, read from the table (missing: empty).
+std::map<std::string, std::vector<double>> read_values(const GlobalTable& table,
+                                                       const std::vector<std::string>& names) {
+  std::map<std::string, std::vector<double>> out;
+  for (const auto& name : names) {
+    const auto v = table.find(name);
+    if (!v) continue;
+    std::vector<std::byte> bytes(table.shape(*v).bytes());
+    if (table.read(*v, bytes.data(), 0).freshness == Freshness::kNoData) continue;
+    out[name] = decode_values(table.shape(*v), bytes.data());
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string describe(const SwitchRecord& r) {
+  std::string text = fmt::format("switch {} -> {} ({})", r.from, r.to, r.cause);
+  auto part = [&](const char* what, const std::vector<std::string>& names) {
+    if (!names.empty()) text += fmt::format("{} {} {}", text.back() == ')' ? ":" : ";", what, fmt::join(names, ", "));
+  };
+  part("off", r.off);
+  part("on", r.on);
+  part("created", r.spawned);
+  part("reinit", r.reinit);
+  text += fmt::format("{} committed after {}", text.back() == ')' ? ":" : ";",
+                      format_duration(r.committed_ns - r.requested_ns));
+  if (r.flag_raised) text += ", illegal-configuration flag raised meanwhile";
+  return text;
+}
+
+Result<SwitchRecord> Subsystem::switch_to(std::string_view name, std::string_view cause) {
+  std::lock_guard<std::mutex> lock(impl_->ops_mutex);
+  return switch_locked(name, cause, impl_->now());
+}
+
+std::string Subsystem::configuration() const {
+  std::lock_guard<std::mutex> lock(impl_->ops_mutex);
+  return impl_->configuration;
+}
+
+std::vector<SwitchRecord> Subsystem::switches() const {
+  std::lock_guard<std::mutex> lock(impl_->ops_mutex);
+  return impl_->history;
+}
+
+Result<SwitchRecord> Subsystem::switch_locked(std::string_view name, std::string_view cause,
+                                              std::int64_t requested_ns) {
+  Impl& m = *impl_;
+  if (m.stopped) return make_error(Errc::kState, "the subsystem is stopped");
+  const ConfigurationSpec* target = m.spec.find_configuration(name);
+  if (target == nullptr) {
+    auto known = check_configuration_name(m.spec, name);
+    return make_error(Errc::kNotFound, fmt::format("switch: {}", known.error().message));
+  }
+  if (target->name == m.configuration)
+    return make_error(Errc::kState, fmt::format("switch: configuration '{}' is already on", target->name));
+  // Phase 1, prepare: verify, plan, create what is missing. Nothing has changed if this fails.
+  auto violations = verify_tasks(m.resolution.subsystem, target->tasks, target->name);
+  if (!violations.empty()) return make_error(Errc::kIllegal, fmt::format("switch: {}", violations.front().message));
+  std::vector<SwitchTask> states;
+  for (const auto& t : m.tasks) states.push_back({t->name(), t->state()});
+  auto plan = plan_switch(states, target->tasks);
+  if (!plan)
+    return make_error(plan.error().code, fmt::format("switch to '{}' refused: {}", name, plan.error().message));
+
+  SwitchRecord record;
+  record.from = m.configuration;
+  record.to = target->name;
+  record.cause = std::string(cause);
+  record.requested_ns = requested_ns;
+  record.off = names_of(m.tasks, plan->leaving);
+  record.on = names_of(m.tasks, plan->joining);
+  record.spawned = names_of(m.tasks, plan->to_spawn);
+  record.flag_raised = !plan->to_spawn.empty();
+
+  // A switch that must create tasks takes longer than a cycle: the flag tells every module so,
+  // and critical ones (the robot interfaces) hold still until it is lowered.
+  m.switching_flag = record.flag_raised;
+  m.update_flag();
+  std::vector<std::size_t> created;
+  for (const std::size_t i : plan->to_spawn) {
+    if (auto r = m.signal(i, Signal::kSpawn); !r) {
+      for (auto it = created.rbegin(); it != created.rend(); ++it) (void)m.signal(*it, Signal::kKill);
+      m.switching_flag = false;
+      m.update_flag();
+      m.collect_events();
+      return make_error(r.error().code,
+                        fmt::format("switch to '{}' refused: {}; nothing changed", name, r.error().message));
+    }
+    created.push_back(i);
+  }
+
+  // The in-consts that may change value: the out-consts of the tasks leaving and joining.
+  std::vector<std::string> consts;
+  for (const std::size_t i : plan->leaving)
+    for (auto& c : m.tasks[i]->const_outputs()) consts.push_back(std::move(c));
+  for (const std::size_t i : plan->joining)
+    for (auto& c : m.tasks[i]->const_outputs()) consts.push_back(std::move(c));
+  const auto before = read_values(*m.table, consts);
+
+  // Phase 2, commit at one cycle boundary.
+  std::int64_t shortest = 0;
+  for (const std::size_t i : plan->leaving)
+    if (m.tasks[i]->periodic())
+      shortest = shortest == 0 ? m.tasks[i]->period_ns() : std::min(shortest, m.tasks[i]->period_ns());
+  for (const std::size_t i : plan->joining)
+    if (m.tasks[i]->periodic())
+      shortest = shortest == 0 ? m.tasks[i]->period_ns() : std::min(shortest, m.tasks[i]->period_ns());
+  const ConfigurationSpec* from_config = m.spec.find_configuration(m.configuration);
+  m.plan = make_schedule_plan(m.resolution.subsystem, m.order, subsystem_cpus(m.spec), target->tasks);
+  Result<void> committed;
+  if (m.virtual_exec) {
+    // Creating tasks takes no simulated time, but a switch that must create them is one that
+    // takes longer than a cycle: the old configuration runs on, flag raised, until the next
+    // boundary of the fastest task involved.
+    if (record.flag_raised && shortest > 0) {
+      const std::int64_t now = m.virtual_exec->now_ns();
+      (void)m.virtual_exec->run_until((now / shortest + 1) * shortest);
+    }
+    for (const std::size_t i : plan->leaving) (void)m.signal(i, Signal::kOff);
+    for (const std::size_t i : plan->joining)
+      if (auto r = m.signal(i, Signal::kOn); !r && committed) committed = r;
+    m.virtual_exec->set_plan(m.plan);
+  } else {
+    const std::int64_t now = m.real_exec->now_ns();
+    const std::int64_t at = shortest > 0 ? ((now + kCommitMarginNs) / shortest + 1) * shortest : now;
+    committed = m.real_exec->commit_switch(plan->leaving, plan->joining, at);
+    m.real_exec->set_plan(m.plan);
+  }
+  record.committed_ns = m.now();
+  m.configuration = target->name;
+  (void)from_config;
+
+  // Consumers of a constant whose value changed read it anew before their next cycle.
+  const auto after = read_values(*m.table, consts);
+  std::vector<std::string> changed;
+  for (const auto& [var, value] : after) {
+    const auto old = before.find(var);
+    if (old == before.end() || old->second != value) changed.push_back(var);
+  }
+  for (std::size_t i = 0; i < m.tasks.size(); ++i) {
+    Task& t = *m.tasks[i];
+    if (t.state() != TaskState::kOn) continue;
+    if (std::find(plan->joining.begin(), plan->joining.end(), i) != plan->joining.end()) continue;  // read at on()
+    const bool reads =
+        std::any_of(changed.begin(), changed.end(), [&](const std::string& v) { return t.reads_const(v); });
+    if (!reads) continue;
+    record.reinit.push_back(t.name());
+    (void)(m.virtual_exec ? m.virtual_exec->reinit(i) : m.real_exec->reinit(i));
+  }
+
+  m.switching_flag = false;
+  m.update_flag();
+  m.requests->clear();
+  std::fill(m.served.begin(), m.served.end(), -1);
+  m.collect_events();
+  {
+    std::lock_guard<std::mutex> events(m.events_mutex);
+    m.pending.push_back(Event{record.committed_ns, "", describe(record)});
+  }
+  m.history.push_back(record);
+  if (!committed)
+    return make_error(committed.error().code,
+                      fmt::format("{} (switched, with a fault: {})", describe(record), committed.error().message));
+  return record;
+}
+
+void Subsystem::serve_requests() {
+  Impl& m = *impl_;
+  std::lock_guard<std::mutex> lock(m.ops_mutex);
+  if (m.stopped) return;
+  for (std::size_t i = 0; i < m.tasks.size(); ++i) {
+    const int asked = m.requests->asked(i);
+    if (asked < 0 || asked == m.served[i]) continue;
+    m.served[i] = asked;
+    const std::string& to = m.requests->configuration_name(asked);
+    if (to == m.configuration) continue;  // asked for what is on: nothing to do
+    const std::string& by = m.tasks[i]->name();
+    if (m.spec.find_request(m.configuration, to, by) == nullptr) {
+      std::lock_guard<std::mutex> events(m.events_mutex);
+      m.pending.push_back(Event{m.now(), by,
+                                fmt::format("asked for a switch to '{}' from '{}', which the file's requests: do not "
+                                            "allow; refused",
+                                            to, m.configuration)});
+      continue;
+    }
+    auto r = switch_locked(to, fmt::format("requested by {}", by), m.now());
+    if (!r) {
+      std::lock_guard<std::mutex> events(m.events_mutex);
+      m.pending.push_back(Event{m.now(), by, r.error().message});
+    }
+  }
+}
+
+}  // namespace chimera
