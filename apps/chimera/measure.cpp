@@ -70,7 +70,8 @@ Result<analysis::WcetProfile> measure_profile(const SubsystemSpec& spec, const s
   profile.clock = clock == ClockKind::kVirtual ? "virtual" : "real";
   for (const auto& t : least)
     if (t.stats.cycles > 0)
-      profile.tasks.push_back(analysis::measured_entry(t.name, t.stats.exec_max_ns, t.stats.cycles, margin));
+      profile.tasks.push_back(
+          analysis::measured_entry(t.name, t.stats.exec_max_ns, t.stats.cycles, margin, t.stats.exec_p99_ns));
   return profile;
 }
 

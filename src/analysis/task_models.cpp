@@ -32,11 +32,19 @@ std::vector<TaskModel> task_models(const SubsystemSpec& spec, std::span<const st
     m.period_ns = t.period_ns.value_or(0);
     m.deadline_ns = t.deadline_ns;
     m.hard = t.criticality == Criticality::kHard;
+    m.user_priority = t.priority;
     m.cpu = t.cpu.value_or(-1);
     m.file_index = static_cast<int>(i);
-    // When the file gains `priority:` and `server: { budget, period }`, they map here: the
-    // priority to user_priority; a server gets server = true, its budget as wcet_ns, the C found
-    // above (its longest job) as job_wcet_ns, and its period as period_ns and deadline_ns.
+    if (t.server) {
+      // A served aperiodic task: its budget every server period, plus the one job that may run
+      // over it (docs/scheduling.md); the C found above is that longest job.
+      m.server = true;
+      m.wcet_ns = t.server->budget_ns;
+      m.job_wcet_ns = c;
+      m.period_ns = t.server->period_ns;
+    }
+    // late: and virtual_exec: change how a run treats the task, not what analysis assumes
+    // (a skipped release only lightens the load; virtual_exec is simulated time).
     models.push_back(std::move(m));
   }
   return models;

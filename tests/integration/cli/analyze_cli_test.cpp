@@ -153,6 +153,18 @@ TEST_F(AnalyzeTest, TheAssignmentIsShownPerCpu) {
   EXPECT_TRUE(contains(o.out, "on cpus 0, 1;")) << o.out;
 }
 
+TEST_F(AnalyzeTest, AServerCountsItsBudgetAndOneJob) {
+  const auto o = analyze(data("analyze_server.yaml") + " --overhead 0ns");
+  EXPECT_EXIT_CODE(o, 0);
+  EXPECT_TRUE(contains(o.out, "cpu 0: U = 0.800, Liu-Layland bound 0.828 for 2 tasks")) << o.out;
+  EXPECT_EQ(row_of(o.out, "ctl"), "  ctl   assigned  hard         5 ms  file         10 ms  10 ms      8 ms  meets")
+      << o.out;
+  EXPECT_EQ(row_of(o.out, "cmd"), "  cmd   assigned  hard  2 ms + 1 ms  file         10 ms  10 ms      8 ms  meets")
+      << o.out;
+  EXPECT_TRUE(contains(row_of(o.out, "log"), "aperiodic      -         -  background: aperiodic without a server"))
+      << o.out;
+}
+
 TEST_F(AnalyzeTest, EveryConfigurationOrOne) {
   auto o = analyze(data("analyze_two_configs.yaml") + " --overhead 0ns");
   EXPECT_EXIT_CODE(o, 1);

@@ -77,5 +77,32 @@ TEST(TaskModels, OnlyTheNamedTasksWithoutSources) {
   EXPECT_EQ(m[0].file_index, 2);
 }
 
+TEST(TaskModels, PriorityAndServers) {
+  SubsystemSpec spec = spec_of_four();
+  spec.tasks[0].priority = 7;
+  spec.tasks[3].server = ServerSpec{2'000'000, 10'000'000};
+  spec.tasks[3].deadline_ns = 10'000'000;  // the loader's default for a served task
+  WcetProfile profile;
+  profile.tasks.push_back(measured_entry("events", 500'000, 3, 1.0));
+  const std::vector<std::string> names{"filed", "events"};
+  const auto m = task_models(spec, names, &profile);
+  ASSERT_EQ(m.size(), 2U);
+  EXPECT_EQ(m[0].user_priority, 7);
+  EXPECT_FALSE(m[0].server);
+  // The server: its budget per period, and its longest job from the profile.
+  EXPECT_TRUE(m[1].server);
+  EXPECT_EQ(m[1].wcet_ns, 2'000'000);
+  EXPECT_EQ(m[1].job_wcet_ns, 500'000);
+  EXPECT_EQ(m[1].wcet_source, WcetSource::kProfile);
+  EXPECT_EQ(m[1].period_ns, 10'000'000);
+  EXPECT_EQ(m[1].deadline_ns, 10'000'000);
+  EXPECT_FALSE(is_background(m[1]));
+  const auto d = demand_of(m[1], AnalysisOptions{.overhead_ns = 1'000});
+  ASSERT_TRUE(d);
+  EXPECT_EQ(d->c_ns, 2'501'000);
+  // Without a longest job the server cannot be bounded.
+  EXPECT_FALSE(wcet_known(task_models(spec, names)[1]));
+}
+
 }  // namespace
 }  // namespace chimera::analysis
