@@ -57,7 +57,7 @@ Analysed analyse_one(const SubsystemSpec& spec, const ConfigurationSpec& config,
   // The CPUs come from what `chimera run` knows too (the file's wcet: and cpu:), so that the
   // assignment shown is the one a run makes; profile and measurements only refine the analysis.
   const auto cpus = analysis::allowed_cpus(spec, static_cast<int>(::sysconf(_SC_NPROCESSORS_ONLN)));
-  const auto cpu_of = analysis::assign_cpus(analysis::task_models(spec, config.tasks), cpus, spec.scheduler, options);
+  const auto file_cpu = analysis::assign_subsystem_cpus(spec, cpus, options);
 
   std::optional<WcetProfile> measured;
   std::string note;
@@ -76,6 +76,9 @@ Analysed analyse_one(const SubsystemSpec& spec, const ConfigurationSpec& config,
         analysis::kMeasuredMargin, kMeasureRuns, format_period(length));
   }
   const auto models = analysis::task_models(spec, config.tasks, profile, measured ? &*measured : nullptr);
+  std::vector<int> cpu_of;
+  cpu_of.reserve(models.size());
+  for (const auto& m : models) cpu_of.push_back(file_cpu[static_cast<std::size_t>(m.file_index)]);
   const auto result = analysis::analyse_configuration(models, cpu_of, cpus, spec.scheduler, options);
   const analysis::ReportContext context{spec.file, config.name, spec.scheduler, options, note};
   std::fputs(analysis::format_report(context, models, result).c_str(), stdout);

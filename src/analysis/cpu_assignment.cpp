@@ -5,6 +5,7 @@
 
 #include "chimera/analysis/response_time.hpp"
 #include "chimera/analysis/schedulability.hpp"
+#include "chimera/analysis/task_models.hpp"
 #include "chimera/analysis/utilisation.hpp"
 
 namespace chimera::analysis {
@@ -159,6 +160,14 @@ std::vector<int> assign_cpus(std::span<const TaskModel> tasks, std::span<const i
     place(i, *least);
   }
   return cpu_of;
+}
+
+std::vector<int> assign_subsystem_cpus(const SubsystemSpec& spec, std::span<const int> cpus,
+                                       const AnalysisOptions& options) {
+  std::vector<std::string> names;
+  names.reserve(spec.tasks.size());
+  for (const auto& t : spec.tasks) names.push_back(t.name);
+  return assign_cpus(task_models(spec, names), cpus, spec.scheduler, options);  // file order, one per task
 }
 
 std::vector<int> allowed_cpus(const SubsystemSpec& spec, int online_cpus) {

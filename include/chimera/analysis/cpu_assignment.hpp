@@ -25,6 +25,14 @@ namespace chimera::analysis {
 [[nodiscard]] std::vector<int> assign_cpus(std::span<const TaskModel> tasks, std::span<const int> cpus,
                                            SchedulerKind scheduler, const AnalysisOptions& options = {});
 
+/// The CPU of every task of the file (in file order), assigned from what a run knows before it
+/// starts: the file's `wcet:` (and a server's budget) and `cpu:`. Every task of the file takes
+/// part, whichever configuration it is in, so that a task keeps its CPU across switches. The
+/// runtime and `chimera analyze` both call this, so the assignment analysed is the one run.
+/// Not real-time safe.
+[[nodiscard]] std::vector<int> assign_subsystem_cpus(const SubsystemSpec& spec, std::span<const int> cpus,
+                                                     const AnalysisOptions& options = {});
+
 /// The CPUs a subsystem may use: the file's `cpus:`, or 0 .. online_cpus - 1 when it has none.
 [[nodiscard]] std::vector<int> allowed_cpus(const SubsystemSpec& spec, int online_cpus);
 

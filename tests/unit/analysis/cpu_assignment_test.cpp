@@ -90,6 +90,26 @@ TEST(AssignCpus, NoCpusLeavesUnpinnedTasksUnassigned) {
   EXPECT_EQ(assign_cpus(tasks, std::vector<int>{}, SchedulerKind::kRm), (std::vector<int>{-1, 0}));
 }
 
+TEST(AssignSubsystemCpus, EveryTaskOfTheFileFromItsWcetAndCpu) {
+  // Three tasks in two configurations: all are placed, in file order, as assign_cpus() would.
+  SubsystemSpec spec;
+  spec.scheduler = SchedulerKind::kEdf;
+  for (const char* name : {"a", "b", "c"}) {
+    TaskSpec t;
+    t.name = name;
+    t.period_ns = 10'000'000;
+    t.deadline_ns = 10'000'000;
+    spec.tasks.push_back(t);
+  }
+  spec.tasks[0].wcet_ns = 6'000'000;
+  spec.tasks[1].wcet_ns = 3'000'000;
+  spec.tasks[2].cpu = 0;  // unknown C, pinned
+  spec.configurations.push_back(ConfigurationSpec{"one", {"a"}, {}});
+  spec.configurations.push_back(ConfigurationSpec{"two", {"b", "c"}, {}});
+  const std::vector<int> cpus{0, 1};
+  EXPECT_EQ(assign_subsystem_cpus(spec, cpus), (std::vector<int>{0, 1, 0}));
+}
+
 TEST(AllowedCpus, TheFilesListOrEveryOnlineCpu) {
   SubsystemSpec spec;
   EXPECT_EQ(allowed_cpus(spec, 3), (std::vector<int>{0, 1, 2}));
