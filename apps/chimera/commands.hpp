@@ -5,7 +5,12 @@
 #include <optional>
 #include <string>
 
+#include "chimera/analysis/task_model.hpp"
 #include "chimera/exec/subsystem.hpp"
+
+namespace CLI {  // NOLINT(readability-identifier-naming): CLI11's namespace, forward-declared
+class App;
+}  // namespace CLI
 
 namespace chimera::cli {
 
@@ -25,6 +30,17 @@ struct RunArgs {
 };
 /// `chimera run FILE ...`; returns the exit code.
 int run_command(const RunArgs& args);
+
+struct AnalyzeArgs {
+  std::string file;
+  std::optional<std::string> config;
+  std::optional<std::string> wcet_from;
+  std::int64_t overhead_ns = analysis::kDefaultOverheadNs;
+};
+/// Declares `chimera analyze` and its options on `app`; parsing fills `args`.
+CLI::App* add_analyze_command(CLI::App& app, AnalyzeArgs& args);
+/// `chimera analyze FILE [--config NAME] [--wcet-from PROFILE] [--overhead DURATION]`; returns the exit code.
+int analyze_command(const AnalyzeArgs& args);
 
 struct ModulesArgs {
   std::optional<std::string> name;
