@@ -8,6 +8,7 @@ std::string_view wcet_source_name(WcetSource source) {
     case WcetSource::kFile: return "file";
     case WcetSource::kProfile: return "profile";
     case WcetSource::kMeasured: return "measured";
+    case WcetSource::kVirtual: return "virtual_exec";
   }
   return "?";
 }

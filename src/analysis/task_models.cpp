@@ -13,6 +13,7 @@ std::pair<std::int64_t, WcetSource> execution_time(const TaskSpec& t, const Wcet
     if (const ProfileEntry* e = profile->find(t.name)) return {e->wcet_ns, WcetSource::kProfile};
   if (measured != nullptr)
     if (const ProfileEntry* e = measured->find(t.name)) return {e->wcet_ns, WcetSource::kMeasured};
+  if (t.virtual_exec_ns > 0) return {t.virtual_exec_ns, WcetSource::kVirtual};  // a simulated cost, last
   return {0, WcetSource::kUnknown};
 }
 
@@ -43,8 +44,8 @@ std::vector<TaskModel> task_models(const SubsystemSpec& spec, std::span<const st
       m.job_wcet_ns = c;
       m.period_ns = t.server->period_ns;
     }
-    // late: and virtual_exec: change how a run treats the task, not what analysis assumes
-    // (a skipped release only lightens the load; virtual_exec is simulated time).
+    // late: changes how a run treats the task, not what analysis assumes (a skipped release
+    // only lightens the load); virtual_exec counts only where nothing better is known.
     models.push_back(std::move(m));
   }
   return models;

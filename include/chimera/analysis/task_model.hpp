@@ -15,6 +15,7 @@ enum class WcetSource {
   kFile,      // the subsystem file's `wcet:`
   kProfile,   // a profile file (`chimera analyze --wcet-from`, written by `chimera profile`)
   kMeasured,  // a short virtual-clock run by `chimera analyze`, with a safety margin
+  kVirtual,   // the file's `virtual_exec:`, the simulated cost (the virtual clock's own plan)
 };
 
 std::string_view wcet_source_name(WcetSource source);
