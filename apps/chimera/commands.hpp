@@ -42,6 +42,19 @@ CLI::App* add_analyze_command(CLI::App& app, AnalyzeArgs& args);
 /// `chimera analyze FILE [--config NAME] [--wcet-from PROFILE] [--overhead DURATION]`; returns the exit code.
 int analyze_command(const AnalyzeArgs& args);
 
+struct ProfileArgs {
+  std::string file;
+  std::string output;
+  std::optional<std::string> config;
+  std::int64_t for_ns = 10'000'000'000;
+  std::string clock = "real";
+  double margin = 1.2;
+};
+/// Declares `chimera profile` and its options on `app`; parsing fills `args`.
+CLI::App* add_profile_command(CLI::App& app, ProfileArgs& args);
+/// `chimera profile FILE -o PROFILE [--config NAME] [--for DURATION] [--clock C] [--margin X]`.
+int profile_command(const ProfileArgs& args);
+
 struct ModulesArgs {
   std::optional<std::string> name;
 };

@@ -67,6 +67,8 @@ int run_main(int argc, char** argv) {
 
   chimera::cli::AnalyzeArgs analyze;
   auto* analyze_cmd = chimera::cli::add_analyze_command(app, analyze);
+  chimera::cli::ProfileArgs profile;
+  auto* profile_cmd = chimera::cli::add_profile_command(app, profile);
 
   chimera::cli::ModulesArgs modules;
   std::string modules_name;
@@ -86,6 +88,7 @@ int run_main(int argc, char** argv) {
     return chimera::cli::verify_command(verify);
   }
   if (analyze_cmd->parsed()) return chimera::cli::analyze_command(analyze);
+  if (profile_cmd->parsed()) return chimera::cli::profile_command(profile);
   if (run_cmd->parsed()) {
     if (run_config_opt->count() > 0) run.config = run_config;
     if (run_for_opt->count() > 0) run.for_ns = *chimera::parse_duration_ns(run_for);

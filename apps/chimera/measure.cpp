@@ -25,6 +25,7 @@ Result<std::vector<TaskSnapshot>> measure_once(const SubsystemSpec& spec, const 
   options.configuration = configuration;
   options.shm_suffix = fmt::format("_measure_{}_{}", ::getpid(), runs++);
   options.realtime_priorities = clock == ClockKind::kReal;
+  options.measure_cpu_time = true;  // a task's C is its own CPU time, not the wall clock's
   auto created = Subsystem::create(spec, Registry::global(), options);
   if (!created) return created.error();
   Subsystem& subsystem = **created;
