@@ -20,6 +20,7 @@
 namespace chimera {
 
 struct Worker;
+struct TaskThread;
 struct Mail;
 class PriorityDispatcher;
 
@@ -62,7 +63,8 @@ class RealExecutive {
   [[nodiscard]] int fixed_priority(std::size_t index) const;
 
  private:
-  Result<void> start_thread(Worker& w);
+  Result<void> start_thread(TaskThread& thread);
+  void form_threads(const ReleaseOrder& order);
   /// Posts `mail` to a task's thread and waits for its answer. Not real-time safe.
   Result<void> post(Worker& w, Mail mail);
   /// Posts `mail` to several tasks' threads at once, then waits for every answer.
@@ -74,6 +76,7 @@ class RealExecutive {
 
   std::vector<std::unique_ptr<PriorityDispatcher>> dispatchers_;  // outlive the workers that poke them
   std::vector<std::unique_ptr<Worker>> workers_;
+  std::vector<std::unique_ptr<TaskThread>> threads_;
   const GlobalTable& table_;
   std::int64_t epoch_ns_ = 0;
   bool realtime_ = false;
