@@ -281,25 +281,25 @@ void Worker::run_aperiodic() {
   }
 }
 
-void Worker::wait_for_predecessors(std::int64_t k, std::int64_t release_abs) const {
+void Worker::wait_for_predecessors(std::int64_t release, std::int64_t release_abs) const {
   // Bounded: a predecessor that keeps us waiting more than half our deadline no longer holds us
   // back. Counted from when the wait starts, so that the order still holds while tasks catch up
   // after a stall (when every release is already in the past).
   const std::int64_t give_up = std::max(release_abs, monotonic_ns()) + task->spec().deadline_ns / 2;
   for (Worker* p : predecessors) {
     for (;;) {
-      if (reached(p->completed.load(std::memory_order_acquire), k)) break;      // acquire: its cycle is done
+      if (reached(p->completed.load(std::memory_order_acquire), release)) break;      // acquire: its cycle is done
       const std::int64_t joins = p->joining_k.load(std::memory_order_acquire);  // acquire: pairs with the commit
-      const bool joining = joins >= 0 && joins <= k;
+      const bool joining = joins >= 0 && joins <= release;
       if (!joining) {
         if (p->task->state() != TaskState::kOn) break;
         const std::int64_t s = p->scheduled.load(std::memory_order_acquire);  // acquire: pairs with its store
-        if (s < 0 || s > k) break;  // not released, or joined after this instant
+        if (s < 0 || s > release) break;  // not released, or joined after this instant
       }
       p->waiters.fetch_add(1, std::memory_order_seq_cst);  // seq_cst: Dekker with the producer (see run_periodic)
       const std::uint32_t c = p->completed.load(std::memory_order_seq_cst);
       bool in_time = true;
-      if (!reached(c, k)) in_time = detail::futex_wait(p->completed, c, give_up);
+      if (!reached(c, release)) in_time = detail::futex_wait(p->completed, c, give_up);
       p->waiters.fetch_sub(1, std::memory_order_relaxed);  // only a hint for the producer's wake
       if (!in_time && monotonic_ns() >= give_up) {
         task->record_order_timeout();

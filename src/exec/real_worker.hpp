@@ -144,7 +144,7 @@ struct Worker {
   void leave();
   /// A pending kOnAt whose release has come: turns on and answers.
   void join_now();
-  void wait_for_predecessors(std::int64_t k, std::int64_t release_abs) const;
+  void wait_for_predecessors(std::int64_t release, std::int64_t release_abs) const;
   /// Runs one job and tells successors and subscribers; returns the execution time it used.
   std::int64_t run_job(std::int64_t release_abs);
   void publish_job(std::int64_t release_abs);
