@@ -288,15 +288,15 @@ void Worker::wait_for_predecessors(std::int64_t release, std::int64_t release_ab
   const std::int64_t give_up = std::max(release_abs, monotonic_ns()) + task->spec().deadline_ns / 2;
   for (Worker* p : predecessors) {
     for (;;) {
-      if (reached(p->completed.load(std::memory_order_acquire), release)) break;      // acquire: its cycle is done
-      const std::int64_t joins = p->joining_k.load(std::memory_order_acquire);  // acquire: pairs with the commit
+      if (reached(p->completed.load(std::memory_order_acquire), release)) break;  // acquire: its cycle is done
+      const std::int64_t joins = p->joining_k.load(std::memory_order_acquire);    // acquire: pairs with the commit
       const bool joining = joins >= 0 && joins <= release;
       if (!joining) {
         if (p->task->state() != TaskState::kOn) break;
         const std::int64_t s = p->scheduled.load(std::memory_order_acquire);  // acquire: pairs with its store
         if (s < 0 || s > release) break;  // not released, or joined after this instant
       }
-      p->waiters.fetch_add(1, std::memory_order_seq_cst);  // seq_cst: Dekker with the producer (see run_periodic)
+      p->waiters.fetch_add(1, std::memory_order_seq_cst);  // seq_cst: Dekker with the producer (see act)
       const std::uint32_t c = p->completed.load(std::memory_order_seq_cst);
       bool in_time = true;
       if (!reached(c, release)) in_time = detail::futex_wait(p->completed, c, give_up);
