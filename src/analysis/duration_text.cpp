@@ -33,7 +33,7 @@ std::string in_unit(std::int64_t thousandths, const Unit& unit, DurationStyle st
 }  // namespace
 
 std::string duration_text(std::int64_t ns, DurationStyle style) {
-  if (ns < 0) return "-" + duration_text(-ns, style);
+  if (ns < 0) return fmt::format("-{}", duration_text(-ns, style));  // (not "-" + ...: GCC 12's -Wrestrict misfires)
   std::size_t first = 0;
   while (first < kUnits.size() && ns < kUnits[first].ns) ++first;
   if (first == kUnits.size()) return fmt::format("{}{}ns", ns, style == DurationStyle::kDisplay ? " " : "");
