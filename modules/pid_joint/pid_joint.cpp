@@ -6,6 +6,7 @@
 
 #include "chimera/module/registry.hpp"
 #include "pid_law.hpp"
+#include "support/module_support.hpp"
 
 namespace chimera::modules {
 namespace {
@@ -17,16 +18,6 @@ Vector default_ki() { return {2500, 5000, 2500, 300, 300, 200}; }
 Vector default_kd() { return {150, 200, 100, 20, 20, 15}; }
 Vector default_tau_max() { return {150, 150, 80, 20, 20, 20}; }
 Vector default_i_max() { return {0.05, 0.05, 0.05, 0.05, 0.05, 0.05}; }
-
-// A per-joint parameter: ndof entries, or one for every joint. Empty on a wrong length.
-Vector per_joint(const Params& p, std::string_view name, Vector fallback, std::size_t n) {
-  Vector v = p.vector(name, std::move(fallback));
-  if (v.size() == 1) v.assign(n, v[0]);
-  if (v.size() != n) v.clear();
-  for (double x : v)
-    if (!std::isfinite(x) || x < 0.0) v.clear();
-  return v;
-}
 
 class PidJoint final : public Module {
  public:
@@ -82,7 +73,10 @@ class PidJoint final : public Module {
     g.kd = per_joint(p, "kd", default_kd(), n);
     g.tau_max = per_joint(p, "tau_max", default_tau_max(), n);
     g.i_max = per_joint(p, "i_max", default_i_max(), n);
-    if (g.kp.empty() || g.ki.empty() || g.kd.empty() || g.tau_max.empty() || g.i_max.empty())
+    const bool valid = !g.kp.empty() && !g.ki.empty() && !g.kd.empty() && !g.tau_max.empty() && !g.i_max.empty() &&
+                       all_non_negative(g.kp) && all_non_negative(g.ki) && all_non_negative(g.kd) &&
+                       all_non_negative(g.tau_max) && all_non_negative(g.i_max);
+    if (!valid)
       return Status::fail("pid_joint: kp, ki, kd, tau_max and i_max need ndof (or 1) values, none negative");
     law_.configure(std::move(g), dt);
     return Status::ok();

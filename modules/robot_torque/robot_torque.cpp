@@ -4,27 +4,17 @@
 #include <cmath>
 #include <cstdint>
 #include <memory>
-#include <mutex>
-#include <set>
 #include <string>
 
 #include "chimera/module/registry.hpp"
 #include "chimera/sim/arm_sim.hpp"
+#include "support/module_support.hpp"
 
 namespace chimera::modules {
 namespace {
 
 constexpr double kDefaultNdof = 6.0;
 constexpr int kMaxNdof = 64;
-
-// Status carries only static strings; a message built at init (with a path or a count) is kept
-// here for the life of the program. Each distinct message is stored once.
-const char* intern(std::string message) {
-  static std::mutex mutex;
-  static std::set<std::string> texts;
-  const std::lock_guard lock(mutex);
-  return texts.insert(std::move(message)).first->c_str();
-}
 
 // The port sizes come from the ndof parameter, because ndof is this module's out-const and the
 // resolver only sizes ports from a task's own in-consts.

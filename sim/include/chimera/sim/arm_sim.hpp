@@ -1,7 +1,8 @@
 #pragma once
-// A simulated robot arm (MuJoCo) for the robot interfaces' resource port: joint torques in,
-// measured joint positions and velocities out, on simulated time that advances only when the
-// caller steps it. A real arm's driver would sit in the same place behind the same module.
+// A simulated robot arm (MuJoCo) for the robot interfaces' resource port: joint torques in (or,
+// in position mode, joint positions for the arm's own servo), measured joint positions and
+// velocities out, on simulated time that advances only when the caller steps it. A real arm's
+// driver would sit in the same place behind the same module.
 
 #include <array>
 #include <cstdint>
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include "chimera/core/result.hpp"
+#include "chimera/sim/gaussian_noise.hpp"
 
 struct mjModel_;
 struct mjData_;
@@ -35,6 +37,29 @@ struct SensorNoise {
   double position_std = 0.0;  // rad (or m for a slide joint)
   double velocity_std = 0.0;  // rad/s
   std::uint64_t seed = 1;     // fixed seed: the same run gives the same noise
+};
+
+/// How the arm's motors are driven.
+enum class Drive {
+  kTorque,    // the torques given by set_torque
+  kPosition,  // the arm's own position servo, run at every physics step, toward set_position_target
+};
+
+/// The position servo's gains, ndof entries each.
+struct ServoGains {
+  std::vector<double> kp;         // N*m/rad
+  std::vector<double> kd;         // N*m*s/rad
+  std::vector<double> max_speed;  // rad/s: how fast the servo's reference may move toward the target
+};
+
+/// Bandwidth and reference speed limit of the servo a freshly loaded arm has.
+inline constexpr double kDefaultServoBandwidthHz = 10.0;
+inline constexpr double kDefaultServoMaxSpeed = 3.0;  // rad/s
+
+/// The pose of a site of the model in the world frame; rotation row-major (site axes as columns).
+struct SitePose {
+  std::array<double, 3> position{};
+  std::array<double, 9> rotation{};
 };
 
 /// One arm: a MuJoCo model whose actuator i is a motor on joint i, one degree of freedom each.
@@ -63,9 +88,36 @@ class ArmSim {
   [[nodiscard]] double torque_min(int i) const noexcept;
   [[nodiscard]] double torque_max(int i) const noexcept;
 
+  /// Lower and upper limits of joint i's range (rad, or m for a slide); +-infinity if unlimited.
+  /// Real-time safe.
+  [[nodiscard]] double joint_min(int i) const noexcept;
+  [[nodiscard]] double joint_max(int i) const noexcept;
+
+  /// How the motors are driven (kTorque after load). Entering kPosition starts the servo's
+  /// reference at the arm's present position, at rest, and aims it there until a target is set:
+  /// the arm is held where it is. Real-time safe.
+  void set_drive(Drive drive) noexcept;
+  [[nodiscard]] Drive drive() const noexcept { return drive_; }
+  /// The joint positions the position servo moves the arm to, clamped into the joint ranges;
+  /// missing entries keep their target, a NaN entry is ignored. Real-time safe.
+  void set_position_target(std::span<const double> q) noexcept;
+  [[nodiscard]] std::span<const double> position_target() const noexcept { return target_; }
+  /// Where the servo's reference is: it moves toward the target at no more than max_speed.
+  [[nodiscard]] std::span<const double> position_reference() const noexcept { return reference_; }
+  /// Gains for a critically damped servo of bandwidth `hz` on every joint: w = 2 pi hz,
+  /// kp = m w^2, kd = 2 m w, with m the joint's own inertia (the diagonal of the joint-space
+  /// inertia matrix, motor armature included) in the model's reference posture. Not real-time safe.
+  [[nodiscard]] ServoGains servo_gains(double bandwidth_hz, double max_speed) const;
+  /// Replaces the servo's gains (ndof entries each; kp, kd >= 0, max_speed > 0). A new arm has
+  /// servo_gains(kDefaultServoBandwidthHz, kDefaultServoMaxSpeed). Not real-time safe.
+  Result<void> set_servo_gains(ServoGains gains);
+  [[nodiscard]] const ServoGains& servo() const noexcept { return gains_; }
+
   /// Advances simulated time by dt_ns: as many MuJoCo steps as fit, the remainder carried to the
-  /// next call, so that many calls never drift from the sum of their dt. Real-time safe (MuJoCo
-  /// works in the arena it allocated at load).
+  /// next call, so that many calls never drift from the sum of their dt. In position mode the
+  /// servo runs once a MuJoCo step, on the true state: torque = kp (r - q) + kd (dr/dt - dq/dt)
+  /// + the model's bias (gravity, Coriolis) and joint damping, clamped to the motor limits, where
+  /// r is the reference. Real-time safe (MuJoCo works in the arena it allocated at load).
   void step(std::int64_t dt_ns) noexcept;
   /// Measured joint positions and velocities (with the sensor noise, if any). Real-time safe.
   [[nodiscard]] std::span<const double> positions() const noexcept { return q_meas_; }
@@ -84,10 +136,17 @@ class ArmSim {
   /// Gravity vector in m/s^2 (the model's default is 0 0 -9.81).
   void set_gravity(const std::array<double, 3>& g) noexcept;
 
+  /// The index of the model's site `name` (such as arm6.xml's "tool"). Not real-time safe.
+  [[nodiscard]] Result<int> find_site(std::string_view name) const;
+  /// The true pose of a site at the present joint positions (no sensor noise), from MuJoCo's own
+  /// forward kinematics. Real-time safe.
+  [[nodiscard]] SitePose site_pose(int site) noexcept;
+
  private:
   ArmSim() = default;
   void measure() noexcept;
-  double gaussian() noexcept;
+  void servo_control() noexcept;
+  void hold_here() noexcept;
 
   struct ModelDeleter {
     void operator()(mjModel_* m) const noexcept;
@@ -107,9 +166,12 @@ class ArmSim {
   std::vector<double> q_meas_;  // sized at load, never grown
   std::vector<double> qd_meas_;
   SensorNoise noise_;
-  std::uint64_t rng_ = 0;
-  double spare_normal_ = 0.0;  // Box-Muller yields normals in pairs
-  bool has_spare_ = false;
+  GaussianNoise gaussian_;
+  Drive drive_ = Drive::kTorque;
+  ServoGains gains_;
+  std::vector<double> target_;           // the servo's: sized at load, never grown
+  std::vector<double> reference_;
+  std::vector<double> reference_inertia_;  // joint-space inertia diagonal in the reference posture
 };
 
 }  // namespace chimera::sim
