@@ -5,6 +5,7 @@
 #include <string_view>
 
 #include "chimera/module/registry.hpp"
+#include "module_docs/pid_joint.hpp"
 #include "pid_law.hpp"
 #include "support/module_support.hpp"
 
@@ -22,20 +23,8 @@ Vector default_i_max() { return {0.05, 0.05, 0.05, 0.05, 0.05, 0.05}; }
 class PidJoint final : public Module {
  public:
   static constexpr const char* kName = "pid_joint";
-  static constexpr const char* kSummary = "PID joint position controller: joint torques from position errors";
-  static constexpr const char* kDoc =
-      "The PID joint position controller of the paper's Figure 4: an independent PID loop per joint "
-      "(Craig 1989, Introduction to Robotics, 9 and 10.7). With e = theta_d - theta_m it outputs "
-      "tau_r = kp e + ki int(e) dt + kd (dtheta_d - dtheta_m), saturated to +-tau_max. The integral "
-      "is summed once a cycle (dt = the task's period), kept within +-i_max, and frozen for a joint "
-      "whose output is saturated in the direction of its error (anti-windup by conditional "
-      "integration); on resets it to zero. While any input has not been written yet the output is "
-      "zero torque. No gravity feed-forward: the integral term holds the arm against gravity, as in "
-      "the paper's controller. Parameters, each a list of ndof values or a single value for every "
-      "joint: kp (N*m/rad, default 2500 4000 2500 400 400 300), ki (N*m/(rad*s), default 2500 5000 "
-      "2500 300 300 200), kd (N*m*s/rad, default 150 200 100 20 20 15), tau_max (N*m, default 150 "
-      "150 80 20 20 20, the shipped arm's limits), i_max (rad*s, default 0.05). The defaults are "
-      "tuned for the shipped arm at 1 kHz. See docs/modules/pid_joint.md.";
+  static constexpr const char* kSummary = docs::pid_joint::kSummary;
+  static constexpr const char* kDoc = docs::pid_joint::kText;
 
   static void declare(Declarations& d, const Params& /*params*/) {
     d.in_const("ndof", Dim::fixed(1), "degrees of freedom");

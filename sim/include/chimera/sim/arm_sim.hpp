@@ -45,11 +45,12 @@ enum class Drive {
   kPosition,  // the arm's own position servo, run at every physics step, toward set_position_target
 };
 
-/// The position servo's gains, ndof entries each.
+/// The position servo's gains and the limits of its reference motion, ndof entries each.
 struct ServoGains {
-  std::vector<double> kp;         // N*m/rad
-  std::vector<double> kd;         // N*m*s/rad
-  std::vector<double> max_speed;  // rad/s: how fast the servo's reference may move toward the target
+  std::vector<double> kp;                // N*m/rad
+  std::vector<double> kd;                // N*m*s/rad
+  std::vector<double> max_speed;         // rad/s: fastest motion of the reference toward a target
+  std::vector<double> max_acceleration;  // rad/s^2
 };
 
 /// Bandwidth and reference speed limit of the servo a freshly loaded arm has.
@@ -98,26 +99,38 @@ class ArmSim {
   /// the arm is held where it is. Real-time safe.
   void set_drive(Drive drive) noexcept;
   [[nodiscard]] Drive drive() const noexcept { return drive_; }
+  /// Aims the position servo at where the arm is now, its reference at rest there: the arm
+  /// brakes and stays put (the locally stable mode of a robot interface). Real-time safe.
+  void hold() noexcept;
   /// The joint positions the position servo moves the arm to, clamped into the joint ranges;
-  /// missing entries keep their target, a NaN entry is ignored. Real-time safe.
+  /// missing entries keep their target, a NaN entry is ignored. Called once a period with a
+  /// moving target, it also estimates the target's speed, so that the reference follows it
+  /// without lag. Real-time safe.
   void set_position_target(std::span<const double> q) noexcept;
   [[nodiscard]] std::span<const double> position_target() const noexcept { return target_; }
-  /// Where the servo's reference is: it moves toward the target at no more than max_speed.
+  /// Where the servo's reference is, and how fast it moves: toward the target, as fast as
+  /// max_speed and max_acceleration allow while still able to stop on it (an online trajectory).
   [[nodiscard]] std::span<const double> position_reference() const noexcept { return reference_; }
+  [[nodiscard]] std::span<const double> reference_speed() const noexcept { return reference_speed_; }
   /// Gains for a critically damped servo of bandwidth `hz` on every joint: w = 2 pi hz,
   /// kp = m w^2, kd = 2 m w, with m the joint's own inertia (the diagonal of the joint-space
-  /// inertia matrix, motor armature included) in the model's reference posture. Not real-time safe.
+  /// inertia matrix, motor armature included) in the model's reference posture; max_acceleration
+  /// is half the joint's torque limit over that inertia, so that the other half is left for
+  /// gravity and the pull of the other links. Not real-time safe.
   [[nodiscard]] ServoGains servo_gains(double bandwidth_hz, double max_speed) const;
-  /// Replaces the servo's gains (ndof entries each; kp, kd >= 0, max_speed > 0). A new arm has
-  /// servo_gains(kDefaultServoBandwidthHz, kDefaultServoMaxSpeed). Not real-time safe.
+  /// Replaces the servo's gains (ndof entries each; kp, kd >= 0, max_speed and max_acceleration
+  /// > 0). A new arm has servo_gains(kDefaultServoBandwidthHz, kDefaultServoMaxSpeed). Not
+  /// real-time safe.
   Result<void> set_servo_gains(ServoGains gains);
   [[nodiscard]] const ServoGains& servo() const noexcept { return gains_; }
 
   /// Advances simulated time by dt_ns: as many MuJoCo steps as fit, the remainder carried to the
   /// next call, so that many calls never drift from the sum of their dt. In position mode the
-  /// servo runs once a MuJoCo step, on the true state: torque = kp (r - q) + kd (dr/dt - dq/dt)
-  /// + the model's bias (gravity, Coriolis) and joint damping, clamped to the motor limits, where
-  /// r is the reference. Real-time safe (MuJoCo works in the arena it allocated at load).
+  /// servo runs once a MuJoCo step, on the true state: with r the reference,
+  ///   torque = M(q) r'' + bias(q, q') - damping(q') + kp (r - q) + kd (r' - q'),
+  /// the model's inverse dynamics of the reference motion (inertia, gravity, Coriolis, joint
+  /// damping) plus a PD on what is left, clamped to the motor limits. Real-time safe (MuJoCo works
+  /// in the arena it allocated at load).
   void step(std::int64_t dt_ns) noexcept;
   /// Measured joint positions and velocities (with the sensor noise, if any). Real-time safe.
   [[nodiscard]] std::span<const double> positions() const noexcept { return q_meas_; }
@@ -146,7 +159,7 @@ class ArmSim {
   ArmSim() = default;
   void measure() noexcept;
   void servo_control() noexcept;
-  void hold_here() noexcept;
+  void plan_reference(std::size_t joint, double dt, bool target_moving) noexcept;
 
   struct ModelDeleter {
     void operator()(mjModel_* m) const noexcept;
@@ -169,8 +182,15 @@ class ArmSim {
   GaussianNoise gaussian_;
   Drive drive_ = Drive::kTorque;
   ServoGains gains_;
-  std::vector<double> target_;           // the servo's: sized at load, never grown
+  // The servo's state, sized at load and never grown.
+  std::vector<double> target_;
+  std::vector<double> target_speed_;  // estimated from successive targets
+  std::int64_t target_step_ = 0;      // steps_ when the target was last set
+  std::int64_t target_interval_ = 1;  // steps between the last two targets
   std::vector<double> reference_;
+  std::vector<double> reference_speed_;
+  std::vector<double> reference_acceleration_;
+  std::vector<double> feedforward_;   // M(q) times the reference acceleration
   std::vector<double> reference_inertia_;  // joint-space inertia diagonal in the reference posture
 };
 
