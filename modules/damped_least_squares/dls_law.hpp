@@ -21,7 +21,7 @@ struct DlsSettings {
   double max_linear_speed = 0.5;    // m/s: the commanded tool speed is clipped to this
   double max_angular_speed = 1.5;   // rad/s
   double max_damping = 0.05;        // lambda_max, in m (and rad) like the Jacobian's entries
-  double manipulability_threshold = 0.01;  // w_0: below it the damping sets in
+  double manipulability_threshold = 0.04;  // w_0: below it the damping sets in
 };
 
 /// Wampler and Leifer (1988): with the commanded twist v = gain * pose_error(x_d, x_m), clipped

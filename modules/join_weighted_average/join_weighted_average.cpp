@@ -16,14 +16,11 @@ namespace {
 
 constexpr int kMaxInputs = 64;
 
-// The number of inputs: the parameter inputs, else as many as there are weights, else 2.
+// The number of inputs: the parameter inputs, or when it is 0 (its default) as many as there are
+// weights, or 2.
 int input_count(const Params& p) {
-  double n = 2.0;
-  if (p.has("inputs")) {
-    n = p.number("inputs", 2.0);
-  } else if (p.vector("weights").size() >= 2) {
-    n = static_cast<double>(p.vector("weights").size());
-  }
+  double n = p.number("inputs", 0.0);
+  if (n == 0.0) n = p.vector("weights").size() >= 2 ? static_cast<double>(p.vector("weights").size()) : 2.0;
   if (!(n >= 2.0) || n > kMaxInputs || n != std::floor(n)) return 2;
   return static_cast<int>(n);
 }
@@ -41,16 +38,16 @@ class JoinWeightedAverage final : public Module {
     for (int i = 0; i < n; ++i)
       d.in_var(input_name(i), Dim::follow(), "one producer's value of the quantity (rename it to that producer's variable)");
     d.out_var("out", Dim::follow(), "the weighted average: the one value of the quantity (rename it to its variable)");
-    d.param("inputs", 2.0, "", "number of inputs in_0 ... in_{inputs-1}, from 2 to 64 (default: as many as weights)");
+    d.param("inputs", 0.0, "", "number of inputs in_0 ... in_{inputs-1}, from 2 to 64; 0: as many as weights, or 2");
     d.param("weights", Vector{}, "", "weight of each input, >= 0, not all 0; empty: equal weights");
   }
 
  protected:
   Status init(InitContext& ctx) override {
     const Params& p = ctx.params();
-    const double asked = p.number("inputs", 2.0);
-    if (p.has("inputs") && (!(asked >= 2.0) || asked > kMaxInputs || asked != std::floor(asked)))
-      return Status::fail("join_weighted_average: inputs must be a whole number from 2 to 64");
+    const double asked = p.number("inputs", 0.0);
+    if (asked != 0.0 && (!(asked >= 2.0) || asked > kMaxInputs || asked != std::floor(asked)))
+      return Status::fail("join_weighted_average: inputs must be 0 or a whole number from 2 to 64");
     const int n = input_count(p);
     weights_ = p.vector("weights");
     if (weights_.empty()) weights_.assign(static_cast<std::size_t>(n), 1.0);
