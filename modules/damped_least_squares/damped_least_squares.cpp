@@ -1,12 +1,13 @@
 // damped_least_squares: the damped least-squares controller of the paper's Figure 9 (Wampler and
 // Leifer): joint velocities that move the tool toward x_d, bounded near a singularity.
 
+#include "module_docs/damped_least_squares.hpp"
+
 #include <cmath>
 #include <string>
 
 #include "chimera/module/registry.hpp"
 #include "dls_law.hpp"
-#include "module_docs/damped_least_squares.hpp"
 #include "support/module_support.hpp"
 
 namespace chimera::modules {
@@ -27,9 +28,11 @@ class DampedLeastSquares final : public Module {
     d.out_var("dtheta_d", Dim::of("ndof"), "desired joint velocities, rad/s");
     d.param("gain", defaults.gain, "1/s", "tool twist commanded per unit of pose error");
     d.param("max_linear_speed", defaults.max_linear_speed, "m/s", "the commanded tool speed is clipped to this");
-    d.param("max_angular_speed", defaults.max_angular_speed, "rad/s", "the commanded tool turn rate is clipped to this");
+    d.param("max_angular_speed", defaults.max_angular_speed, "rad/s",
+            "the commanded tool turn rate is clipped to this");
     d.param("max_damping", defaults.max_damping, "m", "lambda at a singularity (the damping when w = 0)");
-    d.param("manipulability_threshold", defaults.manipulability_threshold, "", "w_0: the damping grows as w falls below it");
+    d.param("manipulability_threshold", defaults.manipulability_threshold, "",
+            "w_0: the damping grows as w falls below it");
   }
 
  protected:
@@ -44,7 +47,8 @@ class DampedLeastSquares final : public Module {
     s.manipulability_threshold = p.number("manipulability_threshold", defaults.manipulability_threshold);
     for (const double v : {s.gain, s.max_linear_speed, s.max_angular_speed, s.max_damping, s.manipulability_threshold})
       if (!(v > 0.0) || !std::isfinite(v))
-        return Status::fail("damped_least_squares: gain, speed limits, max_damping and manipulability_threshold must be > 0");
+        return Status::fail(
+            "damped_least_squares: gain, speed limits, max_damping and manipulability_threshold must be > 0");
     law_.configure(s);
 
     x_d_ = ctx.in<double>("x_d");
@@ -76,7 +80,8 @@ class DampedLeastSquares final : public Module {
     for (std::size_t r = 0; r < 6; ++r)
       for (std::size_t c = 0; c < n; ++c)
         jacobian_(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) = jacobian_in_[r * n + c];
-    const kinematics::Vector6 v = law_.twist(kinematics::pose_from(x_d_.values()), kinematics::pose_from(x_m_.values()));
+    const kinematics::Vector6 v =
+        law_.twist(kinematics::pose_from(x_d_.values()), kinematics::pose_from(x_m_.values()));
     law_.update(jacobian_, v, dtheta_d_.values());
     return Status::ok();
   }

@@ -17,10 +17,10 @@
 namespace chimera::modules {
 
 struct DlsSettings {
-  double gain = 10.0;               // 1/s: twist commanded per unit of pose error
-  double max_linear_speed = 0.5;    // m/s: the commanded tool speed is clipped to this
-  double max_angular_speed = 1.5;   // rad/s
-  double max_damping = 0.05;        // lambda_max, in m (and rad) like the Jacobian's entries
+  double gain = 10.0;                      // 1/s: twist commanded per unit of pose error
+  double max_linear_speed = 0.5;           // m/s: the commanded tool speed is clipped to this
+  double max_angular_speed = 1.5;          // rad/s
+  double max_damping = 0.05;               // lambda_max, in m (and rad) like the Jacobian's entries
   double manipulability_threshold = 0.04;  // w_0: below it the damping sets in
 };
 
@@ -47,7 +47,8 @@ class DlsLaw {
 
   /// The commanded twist: gain times the pose error, each part clipped to its speed limit.
   /// Real-time safe.
-  [[nodiscard]] kinematics::Vector6 twist(const kinematics::Pose& desired, const kinematics::Pose& measured) const noexcept {
+  [[nodiscard]] kinematics::Vector6 twist(const kinematics::Pose& desired,
+                                          const kinematics::Pose& measured) const noexcept {
     kinematics::Vector6 v = s_.gain * kinematics::pose_error(desired, measured);
     const double linear = v.head<3>().norm();
     if (linear > s_.max_linear_speed) v.head<3>() *= s_.max_linear_speed / linear;
@@ -58,7 +59,8 @@ class DlsLaw {
 
   /// Joint velocities for the twist v at Jacobian J (6 x n), written to dtheta (n entries).
   /// Real-time safe: fixed-capacity matrices only.
-  void update(const kinematics::JacobianMatrix& jacobian, const kinematics::Vector6& v, std::span<double> dtheta) noexcept {
+  void update(const kinematics::JacobianMatrix& jacobian, const kinematics::Vector6& v,
+              std::span<double> dtheta) noexcept {
     const Eigen::Matrix<double, 6, 6> jjt = jacobian * jacobian.transpose();
     manipulability_ = std::sqrt(std::max(jjt.determinant(), 0.0));
     damping_squared_ = damping_squared(manipulability_);

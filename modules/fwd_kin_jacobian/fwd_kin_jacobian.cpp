@@ -2,12 +2,13 @@
 // x_m and the 6 x ndof geometric Jacobian from the measured joint positions, through an Orocos
 // KDL chain read from the arm's URDF.
 
+#include "module_docs/fwd_kin_jacobian.hpp"
+
 #include <memory>
 #include <string>
 
 #include "chimera/module/registry.hpp"
 #include "kinematics/arm_chain.hpp"
-#include "module_docs/fwd_kin_jacobian.hpp"
 #include "support/chain_params.hpp"
 #include "support/module_support.hpp"
 

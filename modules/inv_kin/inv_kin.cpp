@@ -1,6 +1,8 @@
 // inv_kin: inverse kinematics (paper, Figure 8): the joint positions that put the tool at the
 // desired pose x_d, found numerically within the joint limits, continuing from the last solution.
 
+#include "module_docs/inv_kin.hpp"
+
 #include <algorithm>
 #include <memory>
 #include <optional>
@@ -9,7 +11,6 @@
 
 #include "chimera/module/registry.hpp"
 #include "kinematics/ik_solver.hpp"
-#include "module_docs/inv_kin.hpp"
 #include "support/chain_params.hpp"
 #include "support/module_support.hpp"
 

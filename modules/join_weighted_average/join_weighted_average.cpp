@@ -2,13 +2,14 @@
 // produce the same quantity have their outputs renamed to in_0, in_1, ...; the join publishes
 // one weighted average of them, so that the quantity has a single producer again.
 
+#include "module_docs/join_weighted_average.hpp"
+
 #include <cmath>
 #include <cstddef>
 #include <string>
 #include <vector>
 
 #include "chimera/module/registry.hpp"
-#include "module_docs/join_weighted_average.hpp"
 #include "support/module_support.hpp"
 
 namespace chimera::modules {
@@ -36,7 +37,8 @@ class JoinWeightedAverage final : public Module {
   static void declare(Declarations& d, const Params& p) {
     const int n = input_count(p);
     for (int i = 0; i < n; ++i)
-      d.in_var(input_name(i), Dim::follow(), "one producer's value of the quantity (rename it to that producer's variable)");
+      d.in_var(input_name(i), Dim::follow(),
+               "one producer's value of the quantity (rename it to that producer's variable)");
     d.out_var("out", Dim::follow(), "the weighted average: the one value of the quantity (rename it to its variable)");
     d.param("inputs", 0.0, "", "number of inputs in_0 ... in_{inputs-1}, from 2 to 64; 0: as many as weights, or 2");
     d.param("weights", Vector{}, "", "weight of each input, >= 0, not all 0; empty: equal weights");
@@ -56,7 +58,8 @@ class JoinWeightedAverage final : public Module {
                                  std::to_string(n) + " inputs"));
     double total = 0.0;
     for (const double w : weights_) {
-      if (!(w >= 0.0) || !std::isfinite(w)) return Status::fail("join_weighted_average: weights must be >= 0 and finite");
+      if (!(w >= 0.0) || !std::isfinite(w))
+        return Status::fail("join_weighted_average: weights must be >= 0 and finite");
       total += w;
     }
     if (!(total > 0.0)) return Status::fail("join_weighted_average: the weights must not all be 0");

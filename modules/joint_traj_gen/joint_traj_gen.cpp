@@ -1,11 +1,12 @@
 // joint_traj_gen: the joint position trajectory generator of the paper's Figure 4.
 
+#include "module_docs/joint_traj_gen.hpp"
+
 #include <cmath>
 #include <cstdint>
 #include <vector>
 
 #include "chimera/module/registry.hpp"
-#include "module_docs/joint_traj_gen.hpp"
 #include "quintic_via.hpp"
 
 namespace chimera::modules {

@@ -30,13 +30,10 @@ Result<KDL::Joint> to_kdl_joint(const urdf::Joint& j, const std::string& path) {
   const KDL::Frame origin = to_kdl(j.parent_to_joint_origin_transform);
   const KDL::Vector axis = origin.M * KDL::Vector(j.axis.x, j.axis.y, j.axis.z);
   switch (j.type) {
-    case urdf::Joint::FIXED:
-      return KDL::Joint(j.name, KDL::Joint::Fixed);
+    case urdf::Joint::FIXED: return KDL::Joint(j.name, KDL::Joint::Fixed);
     case urdf::Joint::REVOLUTE:
-    case urdf::Joint::CONTINUOUS:
-      return KDL::Joint(j.name, origin.p, axis, KDL::Joint::RotAxis);
-    case urdf::Joint::PRISMATIC:
-      return KDL::Joint(j.name, origin.p, axis, KDL::Joint::TransAxis);
+    case urdf::Joint::CONTINUOUS: return KDL::Joint(j.name, origin.p, axis, KDL::Joint::RotAxis);
+    case urdf::Joint::PRISMATIC: return KDL::Joint(j.name, origin.p, axis, KDL::Joint::TransAxis);
     default:
       return make_error(Errc::kInvalidInput, "URDF '" + path + "': joint '" + j.name +
                                                  "' is neither revolute, continuous, prismatic nor fixed");
@@ -64,13 +61,13 @@ Result<std::unique_ptr<ArmChain>> ArmChain::load(std::string_view urdf, std::str
 
   // Walk up from the tip to the base, then build the chain from the base down.
   std::vector<urdf::JointConstSharedPtr> joints;
-  while (link->name != base_name) {
-    if (!link->parent_joint)
-      return make_error(Errc::kInvalidInput,
-                        "URDF '" + path + "': link '" + tip_name + "' is not below link '" + base_name + "'");
+  while (link->name != base_name && link->parent_joint) {
     joints.push_back(link->parent_joint);
     link = model->getLink(link->parent_joint->parent_link_name);
   }
+  if (link->name != base_name)
+    return make_error(Errc::kInvalidInput,
+                      "URDF '" + path + "': link '" + tip_name + "' is not below link '" + base_name + "'");
   std::reverse(joints.begin(), joints.end());
 
   std::unique_ptr<ArmChain> arm(new ArmChain());

@@ -16,7 +16,7 @@
 #include "chimera/core/result.hpp"
 #include "kinematics/pose.hpp"
 
-namespace KDL {
+namespace KDL {  // NOLINT(readability-identifier-naming): Orocos KDL's own namespace, declared ahead
 class Chain;
 class ChainFkSolverPos_recursive;
 class ChainJntToJacSolver;
@@ -72,7 +72,7 @@ class ArmChain {
   std::unique_ptr<KDL::Chain> chain_;  // the solvers refer to it: the class neither moves nor copies
   std::unique_ptr<KDL::ChainFkSolverPos_recursive> fk_;
   std::unique_ptr<KDL::ChainJntToJacSolver> jac_solver_;
-  std::unique_ptr<KDL::JntArray> q_;        // sized at load
+  std::unique_ptr<KDL::JntArray> q_;         // sized at load
   std::unique_ptr<KDL::Jacobian> jacobian_;  // sized at load
   std::string path_;
   std::vector<std::string> joint_names_;

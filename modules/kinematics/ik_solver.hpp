@@ -12,11 +12,11 @@
 namespace chimera::kinematics {
 
 struct IkSettings {
-  int max_iterations = 50;           // per solve(): bounds its time
-  double position_tolerance = 1e-9;  // m: converged when both errors are below their tolerance
+  int max_iterations = 50;              // per solve(): bounds its time
+  double position_tolerance = 1e-9;     // m: converged when both errors are below their tolerance
   double orientation_tolerance = 1e-9;  // rad
-  double damping = 1e-6;             // m^2: Sugihara's bias term, the damping that remains at E = 0
-  double max_step = 0.5;             // rad (or m): the largest change of one joint per iteration
+  double damping = 1e-6;                // m^2: Sugihara's bias term, the damping that remains at E = 0
+  double max_step = 0.5;                // rad (or m): the largest change of one joint per iteration
 };
 
 struct IkOutcome {

@@ -1,11 +1,12 @@
 // pid_joint: the PID joint position controller of the paper's Figure 4.
 
+#include "module_docs/pid_joint.hpp"
+
 #include <cmath>
 #include <cstddef>
 #include <string_view>
 
 #include "chimera/module/registry.hpp"
-#include "module_docs/pid_joint.hpp"
 #include "pid_law.hpp"
 #include "support/module_support.hpp"
 
@@ -65,8 +66,7 @@ class PidJoint final : public Module {
     const bool valid = !g.kp.empty() && !g.ki.empty() && !g.kd.empty() && !g.tau_max.empty() && !g.i_max.empty() &&
                        all_non_negative(g.kp) && all_non_negative(g.ki) && all_non_negative(g.kd) &&
                        all_non_negative(g.tau_max) && all_non_negative(g.i_max);
-    if (!valid)
-      return Status::fail("pid_joint: kp, ki, kd, tau_max and i_max need ndof (or 1) values, none negative");
+    if (!valid) return Status::fail("pid_joint: kp, ki, kd, tau_max and i_max need ndof (or 1) values, none negative");
     law_.configure(std::move(g), dt);
     return Status::ok();
   }

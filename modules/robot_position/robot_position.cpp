@@ -2,11 +2,12 @@
 // position-controlled arm, the simulated arm behind its resource port closes its own servo loop,
 // at every physics step; the interface hands it the desired joint positions once a period.
 
+#include "module_docs/robot_position.hpp"
+
 #include <cmath>
 #include <string>
 
 #include "chimera/module/registry.hpp"
-#include "module_docs/robot_position.hpp"
 #include "support/module_support.hpp"
 #include "support/simulated_arm.hpp"
 
@@ -50,7 +51,8 @@ class RobotPosition final : public Module {
       return Status::fail(intern("robot_position: " + set.error().message));
 
     theta_d_ = ctx.in<double>("theta_d");
-    if (!ctx.failed() && theta_d_.size() != n) return Status::fail("robot_position: port sizes differ from parameter ndof");
+    if (!ctx.failed() && theta_d_.size() != n)
+      return Status::fail("robot_position: port sizes differ from parameter ndof");
     sim.set_drive(sim::Drive::kPosition);  // the arm holds its initial posture
     return Status::ok();
   }

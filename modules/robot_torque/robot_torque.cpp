@@ -1,12 +1,13 @@
 // robot_torque: the torque-mode robot interface of the paper's Figure 4. Its resource port is a
 // MuJoCo simulation of a 6-joint arm; a real arm's driver would take the same place.
 
+#include "module_docs/robot_torque.hpp"
+
 #include <cmath>
 #include <span>
 #include <string>
 
 #include "chimera/module/registry.hpp"
-#include "module_docs/robot_torque.hpp"
 #include "support/module_support.hpp"
 #include "support/simulated_arm.hpp"
 
@@ -33,7 +34,8 @@ class RobotTorque final : public Module {
     if (!(bandwidth > 0.0) || !std::isfinite(bandwidth))
       return Status::fail("robot_torque: parameter hold_bandwidth must be > 0 Hz");
     const sim::ServoGains hold = arm_.sim().servo_gains(bandwidth, sim::kDefaultServoMaxSpeed);
-    if (auto set = arm_.sim().set_servo_gains(hold); !set) return Status::fail(intern("robot_torque: " + set.error().message));
+    if (auto set = arm_.sim().set_servo_gains(hold); !set)
+      return Status::fail(intern("robot_torque: " + set.error().message));
     tau_r_ = ctx.in<double>("tau_r");
     if (!ctx.failed() && tau_r_.size() != static_cast<std::size_t>(arm_.sim().ndof()))
       return Status::fail("robot_torque: port sizes differ from parameter ndof");

@@ -1,13 +1,14 @@
 // time_integrator: the time integrator of the paper's Figure 9: desired joint positions from
 // desired joint velocities, for a position-mode robot driven by a rate controller.
 
+#include "module_docs/time_integrator.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
 
 #include "chimera/module/registry.hpp"
-#include "module_docs/time_integrator.hpp"
 #include "support/module_support.hpp"
 
 namespace chimera::modules {

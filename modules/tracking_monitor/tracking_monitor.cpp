@@ -1,10 +1,11 @@
 // tracking_monitor: watches how well measured joint positions follow the desired ones.
 
+#include "module_docs/tracking_monitor.hpp"
+
 #include <algorithm>
 #include <cmath>
 
 #include "chimera/module/registry.hpp"
-#include "module_docs/tracking_monitor.hpp"
 
 namespace chimera::modules {
 namespace {

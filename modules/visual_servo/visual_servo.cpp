@@ -2,6 +2,8 @@
 // visual tracking): a camera that sees a moving target with noise and latency, and the desired
 // tool pose x_d that servoes the tool onto it.
 
+#include "module_docs/visual_servo.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -10,7 +12,6 @@
 
 #include "chimera/module/registry.hpp"
 #include "chimera/sim/gaussian_noise.hpp"
-#include "module_docs/visual_servo.hpp"
 #include "support/module_support.hpp"
 #include "target_path.hpp"
 
@@ -24,7 +25,7 @@ Vector default_center() { return {0.82, 0.10, 0.78, 0.0, 2.356, 0.0}; }
 Vector default_amplitude() { return {0.05, 0.08, 0.04, 0.0, 0.0, 0.0}; }
 Vector default_frequency() { return {0.07, 0.1, 0.06, 0.0, 0.0, 0.0}; }
 Vector default_phase() { return {0.0, 0.0, 1.5708, 0.0, 0.0, 0.0}; }
-constexpr double kDefaultLatency = 0.05;  // s
+constexpr double kDefaultLatency = 0.05;            // s
 constexpr double kDefaultPositionNoise = 0.001;     // m
 constexpr double kDefaultOrientationNoise = 0.002;  // rad
 
@@ -40,7 +41,8 @@ class VisualServo final : public Module {
     d.param("gain", 1.0, "", "fraction of the way from x_m to the seen target that x_d asks for (0 to 1]");
     d.param("latency", kDefaultLatency, "s", "age of the image a result comes from");
     d.param("position_noise", kDefaultPositionNoise, "m", "standard deviation of the error of each seen coordinate");
-    d.param("orientation_noise", kDefaultOrientationNoise, "rad", "standard deviation of the seen orientation's error about each axis");
+    d.param("orientation_noise", kDefaultOrientationNoise, "rad",
+            "standard deviation of the seen orientation's error about each axis");
     d.param("seed", 1.0, "", "seed of the noise (runs repeat exactly)");
     d.param("center", default_center(), "m, rad", "the target's mean pose [x y z rx ry rz]");
     d.param("amplitude", default_amplitude(), "m, rad", "amplitude of each number's sine wave");

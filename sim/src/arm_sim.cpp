@@ -218,8 +218,8 @@ ServoGains ArmSim::servo_gains(double bandwidth_hz, double max_speed) const {
 Result<void> ArmSim::set_servo_gains(ServoGains gains) {
   const auto n = static_cast<std::size_t>(ndof_);
   if (gains.kp.size() != n || gains.kd.size() != n || gains.max_speed.size() != n || gains.max_acceleration.size() != n)
-    return make_error(Errc::kInvalidInput, "servo gains need " + std::to_string(n) +
-                                               " entries each (kp, kd, max_speed, max_acceleration)");
+    return make_error(Errc::kInvalidInput,
+                      "servo gains need " + std::to_string(n) + " entries each (kp, kd, max_speed, max_acceleration)");
   for (std::size_t i = 0; i < n; ++i) {
     if (!(gains.kp[i] >= 0.0) || !(gains.kd[i] >= 0.0) || !std::isfinite(gains.kp[i]) || !std::isfinite(gains.kd[i]))
       return make_error(Errc::kInvalidInput, "servo gains kp and kd must be finite and >= 0");

@@ -111,13 +111,13 @@ double norm(const std::vector<double>& v) {
 }
 
 struct Tracking {
-  double initial_error = 0.0;  // m, tool to target at start
-  double worst_error = 0.0;    // m, after the first 2 s
-  double worst_error_at = 0.0;  // s
-  double rms_error = 0.0;      // m, after the first 2 s
-  double lowest_w = 1.0;       // manipulability
-  double lowest_w_at = 0.0;    // s
-  double fastest_theta_d = 0.0;  // rad/s, |d theta_d / dt| over a period (joint vector norm), after 2 s
+  double initial_error = 0.0;      // m, tool to target at start
+  double worst_error = 0.0;        // m, after the first 2 s
+  double worst_error_at = 0.0;     // s
+  double rms_error = 0.0;          // m, after the first 2 s
+  double lowest_w = 1.0;           // manipulability
+  double lowest_w_at = 0.0;        // s
+  double fastest_theta_d = 0.0;    // rad/s, |d theta_d / dt| over a period (joint vector norm), after 2 s
   double straightest_elbow = 0.0;  // rad, the elbow's closest approach to pi/2 (its distance)
 };
 
@@ -162,9 +162,9 @@ Tracking track(const std::string& config, std::int64_t duration_ns) {
     }
   }
   std::cout << config << ": tool to target " << out.initial_error * 1000 << " mm at start, then (after 2 s) worst "
-            << out.worst_error * 1000 << " mm (at " << out.worst_error_at << " s), RMS " << out.rms_error * 1000 << " mm; lowest manipulability "
-            << out.lowest_w << " at " << out.lowest_w_at << " s, elbow within " << out.straightest_elbow
-            << " rad of straight; fastest theta_d " << out.fastest_theta_d << " rad/s\n";
+            << out.worst_error * 1000 << " mm (at " << out.worst_error_at << " s), RMS " << out.rms_error * 1000
+            << " mm; lowest manipulability " << out.lowest_w << " at " << out.lowest_w_at << " s, elbow within "
+            << out.straightest_elbow << " rad of straight; fastest theta_d " << out.fastest_theta_d << " rad/s\n";
   return out;
 }
 

@@ -15,7 +15,7 @@
 #include "damped_least_squares/dls_law.hpp"
 #include "kinematics_fixture.hpp"
 #include "module_harness.hpp"
-#include "port_contract.hpp"
+#include "support/port_contract.hpp"
 
 namespace chimera::test {
 namespace {

@@ -11,7 +11,7 @@
 #include "chimera/sim/arm_sim.hpp"
 #include "kinematics/pose.hpp"
 #include "module_harness.hpp"
-#include "port_contract.hpp"
+#include "support/port_contract.hpp"
 
 namespace chimera::test {
 namespace {
@@ -69,8 +69,7 @@ TEST(FwdKinJacobian, PoseAndJacobianAreTheSimulatedArmsOwn) {
       auto minus = q;
       plus[c] += kH;
       minus[c] -= kH;
-      const Vector6 column =
-          kinematics::pose_error(sim_tool_pose(**arm, plus), sim_tool_pose(**arm, minus)) / (2 * kH);
+      const Vector6 column = kinematics::pose_error(sim_tool_pose(**arm, plus), sim_tool_pose(**arm, minus)) / (2 * kH);
       for (std::size_t r = 0; r < 6; ++r)
         EXPECT_NEAR(jacobian[r * 6 + c], column[static_cast<Eigen::Index>(r)], 1e-7) << "row " << r << " col " << c;
     }

@@ -42,10 +42,10 @@ tasks:
 )";
 
 struct HoldFigures {
-  double drift_while_held = 0.0;     // rad, worst |theta_m - theta_m at the flag| after 0.5 s held
+  double drift_while_held = 0.0;      // rad, worst |theta_m - theta_m at the flag| after 0.5 s held
   double speed_at_end_of_hold = 0.0;  // rad/s
-  double trajectory_moved = 0.0;     // rad, how far theta_d went meanwhile (ignored by the robot)
-  double error_after_resume = 0.0;   // rad, worst |theta_d - theta_m| in the last second
+  double trajectory_moved = 0.0;      // rad, how far theta_d went meanwhile (ignored by the robot)
+  double error_after_resume = 0.0;    // rad, worst |theta_d - theta_m| in the last second
 };
 
 HoldFigures raise_and_clear(const std::string& text, double resume_tolerance) {

@@ -12,7 +12,7 @@
 
 #include "kinematics_fixture.hpp"
 #include "module_harness.hpp"
-#include "port_contract.hpp"
+#include "support/port_contract.hpp"
 
 namespace chimera::test {
 namespace {
@@ -69,8 +69,9 @@ TEST(InvKin, KeepsWithinItsJointLimits) {
   const std::vector<double> truth{0.2, 0.3, 1.0, 0.4, 0.8, -0.2};
   ScriptedSource::set("joints", {0.2, 0.3, 0.5, 0.4, 0.8, -0.2});
   ScriptedSource::set("goal", tool_pose(truth));
-  const std::string text = replaced(kFile, "module: inv_kin, period: 1ms }",
-                                    "module: inv_kin, period: 1ms, params: { upper: [2.79, 1.75, 0.6, 4.6, 1.75, 4.6] } }");
+  const std::string text =
+      replaced(kFile, "module: inv_kin, period: 1ms }",
+               "module: inv_kin, period: 1ms, params: { upper: [2.79, 1.75, 0.6, 4.6, 1.75, 4.6] } }");
   auto sub = start_subsystem(text);
   ASSERT_NE(sub, nullptr);
   sub->run_for(50 * kMs);

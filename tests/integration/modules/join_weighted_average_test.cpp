@@ -8,7 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "module_harness.hpp"
-#include "port_contract.hpp"
+#include "support/port_contract.hpp"
 
 namespace chimera::test {
 namespace {
@@ -31,8 +31,9 @@ tasks:
 )";
 
 TEST(JoinWeightedAverage, PortsFollowTheirVariablesAndTheNumberOfInputs) {
-  expect_ports("join_weighted_average",
-               {{"in_0", PortKind::kInVar, "any"}, {"in_1", PortKind::kInVar, "any"}, {"out", PortKind::kOutVar, "any"}});
+  expect_ports(
+      "join_weighted_average",
+      {{"in_0", PortKind::kInVar, "any"}, {"in_1", PortKind::kInVar, "any"}, {"out", PortKind::kOutVar, "any"}});
   Params three;
   three.set("inputs", 3.0);
   expect_ports("join_weighted_average",
@@ -78,8 +79,9 @@ TEST(JoinWeightedAverage, RefusesBadWeightsAndMixedShapes) {
   ScriptedSource::set("a", {0.0, 0.0, 0.0});
   ScriptedSource::set("b", {0.0, 0.0, 0.0});
   ScriptedSource::set("c", {0.0, 0.0, 0.0});
-  EXPECT_NE(start_error(replaced(kFile, "weights: [1, 2, 5]", "inputs: 3, weights: [1, 2]")).find("2 weights for 3 inputs"),
-            std::string::npos);
+  EXPECT_NE(
+      start_error(replaced(kFile, "weights: [1, 2, 5]", "inputs: 3, weights: [1, 2]")).find("2 weights for 3 inputs"),
+      std::string::npos);
   EXPECT_NE(start_error(replaced(kFile, "weights: [1, 2, 5]", "weights: [1, -2, 5]")).find("weights must be >= 0"),
             std::string::npos);
   EXPECT_NE(start_error(replaced(kFile, "weights: [1, 2, 5]", "weights: [0, 0, 0]")).find("must not all be 0"),

@@ -11,7 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "module_harness.hpp"
-#include "port_contract.hpp"
+#include "support/port_contract.hpp"
 
 namespace chimera::test {
 namespace {
@@ -63,7 +63,7 @@ TEST(RobotPosition, TheArmFollowsAJointTrajectory) {
     moved = std::max(moved, max_abs_difference(theta_m, start));
   }
   std::cout << "robot_position following joint_traj_gen for 5.5 s: worst error " << worst << " rad\n";
-  EXPECT_GT(moved, 1.0);     // the default motion swings joints by more than a radian
+  EXPECT_GT(moved, 1.0);   // the default motion swings joints by more than a radian
   EXPECT_LT(worst, 1e-4);  // the servo follows a smooth theta_d without lag
   EXPECT_EQ(sub->now_ns(), 5500 * kMs);
   for (const auto& t : sub->snapshot()) EXPECT_EQ(t.state, TaskState::kOn) << t.name << ": " << t.last_error;
@@ -72,7 +72,8 @@ TEST(RobotPosition, TheArmFollowsAJointTrajectory) {
 TEST(RobotPosition, AJumpBecomesASmoothMoveWithinMaxSpeed) {
   const std::vector<double> goal{1.0, -0.5, 0.8, 2.0, -1.0, 1.5};
   ScriptedSource::set("goal", goal);
-  auto sub = start_subsystem(replaced(kStep, "initial: [0, 0, 0, 0, 0, 0]", "initial: [0, 0, 0, 0, 0, 0], max_speed: [1.5]"));
+  auto sub =
+      start_subsystem(replaced(kStep, "initial: [0, 0, 0, 0, 0, 0]", "initial: [0, 0, 0, 0, 0, 0], max_speed: [1.5]"));
   ASSERT_NE(sub, nullptr);
   double fastest = 0.0;
   for (int k = 0; k < 2500; ++k) {
@@ -104,8 +105,9 @@ TEST(RobotPosition, TheSimulationStepsInLockstepWithThePeriod) {
 TEST(RobotPosition, TwoRunsAreBitIdentical) {
   const auto run = [] {
     std::vector<double> trace;
-    auto sub = start_subsystem(replaced(kTrajectory, "module: robot_position, period: 1ms }",
-                                        "module: robot_position, period: 1ms, params: { noise_std: 0.001, seed: 4 } }"));
+    auto sub =
+        start_subsystem(replaced(kTrajectory, "module: robot_position, period: 1ms }",
+                                 "module: robot_position, period: 1ms, params: { noise_std: 0.001, seed: 4 } }"));
     if (!sub) return trace;
     for (int k = 0; k < 100; ++k) {
       sub->run_for(10 * kMs);
@@ -124,12 +126,15 @@ TEST(RobotPosition, BadParametersAreNamed) {
   EXPECT_NE(start_error(replaced(kStep, "initial: [0, 0, 0, 0, 0, 0]", "initial: [0, 0, 0, 0, 0, 0], bandwidth: 0"))
                 .find("bandwidth must be > 0"),
             std::string::npos);
-  EXPECT_NE(start_error(replaced(kStep, "initial: [0, 0, 0, 0, 0, 0]", "initial: [0, 0, 0, 0, 0, 0], max_speed: [1, 2]"))
-                .find("max_speed and max_acceleration need ndof"),
-            std::string::npos);
-  EXPECT_NE(start_error(replaced(kStep, "initial: [0, 0, 0, 0, 0, 0]", "initial: [0, 0, 0]")).find("parameter initial has 3"),
-            std::string::npos);
-  EXPECT_NE(start_error(replaced(kStep, "initial: [0, 0, 0, 0, 0, 0]", "initial: [0, 0, 0, 0, 0, 0], model: /nonexistent/arm.xml"))
+  EXPECT_NE(
+      start_error(replaced(kStep, "initial: [0, 0, 0, 0, 0, 0]", "initial: [0, 0, 0, 0, 0, 0], max_speed: [1, 2]"))
+          .find("max_speed and max_acceleration need ndof"),
+      std::string::npos);
+  EXPECT_NE(
+      start_error(replaced(kStep, "initial: [0, 0, 0, 0, 0, 0]", "initial: [0, 0, 0]")).find("parameter initial has 3"),
+      std::string::npos);
+  EXPECT_NE(start_error(replaced(kStep, "initial: [0, 0, 0, 0, 0, 0]",
+                                 "initial: [0, 0, 0, 0, 0, 0], model: /nonexistent/arm.xml"))
                 .find("/nonexistent/arm.xml"),
             std::string::npos);
 }

@@ -8,7 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "module_harness.hpp"
-#include "port_contract.hpp"
+#include "support/port_contract.hpp"
 
 namespace chimera::test {
 namespace {

@@ -13,7 +13,7 @@
 
 #include "kinematics_fixture.hpp"
 #include "module_harness.hpp"
-#include "port_contract.hpp"
+#include "support/port_contract.hpp"
 #include "visual_servo/target_path.hpp"
 
 namespace chimera::test {
@@ -142,7 +142,8 @@ TEST(VisualServo, TheCameraErrsAsAskedAndRepeatsFromItsSeed) {
   EXPECT_NEAR(a.angle_rms, 0.004 * std::sqrt(3.0), 0.0004);
   // The same seed: the same errors, bit for bit; another seed: others.
   EXPECT_EQ(seen_noise(noisy).errors, a.errors);
-  const NoiseStats other = seen_noise(replaced(noisy, "      latency: 0.075\n", "      latency: 0.075\n      seed: 2\n"));
+  const NoiseStats other =
+      seen_noise(replaced(noisy, "      latency: 0.075\n", "      latency: 0.075\n      seed: 2\n"));
   ASSERT_EQ(other.errors.size(), a.errors.size());
   EXPECT_NE(other.errors, a.errors);
 }
@@ -163,9 +164,10 @@ tasks:
   for (const auto& p : d.params()) {
     const auto* v = std::get_if<Vector>(&p.default_value);
     if (v == nullptr) continue;
-    auto& slot = p.name == "center" ? defaults.center : p.name == "amplitude" ? defaults.amplitude
-                                                    : p.name == "frequency" ? defaults.frequency
-                                                                            : defaults.phase;
+    auto& slot = p.name == "center"      ? defaults.center
+                 : p.name == "amplitude" ? defaults.amplitude
+                 : p.name == "frequency" ? defaults.frequency
+                                         : defaults.phase;
     std::copy(v->begin(), v->end(), slot.begin());
   }
   const modules::TargetPath path(defaults);
@@ -178,8 +180,8 @@ tasks:
     lowest_w = std::min(lowest_w, std::fabs(j.determinant()));
     if (k >= 200) {
       const double t = 0.010 * (k + 1);
-      worst_error = std::max(worst_error, kinematics::position_norm(pose_difference(value_of(*sub, "x_m"),
-                                                                                   sample(path, t))));
+      worst_error =
+          std::max(worst_error, kinematics::position_norm(pose_difference(value_of(*sub, "x_m"), sample(path, t))));
     }
   }
   std::cout << "default path, Figure 8, 20 s: lowest manipulability " << lowest_w << ", worst tool-to-target "
@@ -192,7 +194,8 @@ tasks:
 
 TEST(VisualServo, BadParametersDoNotStart) {
   ScriptedSource::set("tool", {0.7, 0.0, 0.9, 0.0, 2.0, 0.0});
-  EXPECT_NE(start_error(replaced(kFile, "      latency: 0.075\n", "      latency: 0.075\n      gain: 0\n")).find("gain must be in (0, 1]"),
+  EXPECT_NE(start_error(replaced(kFile, "      latency: 0.075\n", "      latency: 0.075\n      gain: 0\n"))
+                .find("gain must be in (0, 1]"),
             std::string::npos);
   EXPECT_NE(start_error(replaced(kFile, "latency: 0.075", "latency: -1")).find("must be >= 0"), std::string::npos);
   EXPECT_NE(start_error(replaced(kFile, "phase: [0, 1, 2, 3, 4, 5]", "phase: [0, 1]")).find("need 6 (or 1)"),

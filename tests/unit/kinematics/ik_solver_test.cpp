@@ -53,6 +53,25 @@ bool near_singular(const std::vector<double>& q, double margin) {
   return std::fabs(std::fabs(q[2]) - std::numbers::pi / 2) < margin || std::fabs(q[4]) < margin;
 }
 
+// A posture 0.3 rad inside the limits and away from singular postures (RoundTripsNearSingular-
+// Postures has those), and a seed up to `spread` / 2 away from it on every joint.
+struct Sample {
+  std::vector<double> truth;
+  std::vector<double> seed;
+};
+Sample draw(Uniform& uniform, const ArmChain& chain, double spread) {
+  Sample s{std::vector<double>(6), std::vector<double>(6)};
+  do {
+    for (std::size_t i = 0; i < 6; ++i) {
+      const double lo = chain.lower()[i] + 0.3;
+      const double hi = chain.upper()[i] - 0.3;
+      s.truth[i] = lo + uniform() * (hi - lo);
+      s.seed[i] = s.truth[i] + spread * (uniform() - 0.5);
+    }
+  } while (near_singular(s.truth, 0.05));
+  return s;
+}
+
 TEST(IkSolver, RoundTripsFromANearbySeed) {
   auto chain = load_chain();
   ASSERT_NE(chain, nullptr);
@@ -63,20 +82,8 @@ TEST(IkSolver, RoundTripsFromANearbySeed) {
   double worst_position = 0.0;
   double worst_orientation = 0.0;
   int worst_iterations = 0;
-  int solved = 0;
-  while (solved < 300) {
-    // Postures away from the limits' edges and from singular postures (next test), seeds within
-    // 0.5 rad of them on every joint.
-    std::vector<double> truth(6);
-    std::vector<double> seed(6);
-    for (std::size_t i = 0; i < 6; ++i) {
-      const double lo = chain->lower()[i] + 0.3;
-      const double hi = chain->upper()[i] - 0.3;
-      truth[i] = lo + uniform() * (hi - lo);
-      seed[i] = truth[i] + (uniform() - 0.5);
-    }
-    if (near_singular(truth, 0.05)) continue;
-    const int k = solved++;
+  for (int k = 0; k < 300; ++k) {
+    const auto [truth, seed] = draw(uniform, *chain, 1.0);
     const Pose target = chain->forward(truth);
     std::vector<double> q(6);
     const IkOutcome out = ik.solve(target, seed, q);
@@ -122,18 +129,9 @@ TEST(IkSolver, ReachesPosesFromDistantSeedsWithinTheLimits) {
   IkSolver ik = make_solver(*chain, settings);
   Uniform uniform;
   int converged = 0;
-  int tried = 0;
-  while (tried < 200) {
-    std::vector<double> truth(6);
-    std::vector<double> seed(6);
-    for (std::size_t i = 0; i < 6; ++i) {
-      const double lo = chain->lower()[i] + 0.3;
-      const double hi = chain->upper()[i] - 0.3;
-      truth[i] = lo + uniform() * (hi - lo);
-      seed[i] = truth[i] + 2.0 * (uniform() - 0.5);  // up to 1 rad away on every joint
-    }
-    if (near_singular(truth, 0.05)) continue;
-    ++tried;
+  constexpr int kTried = 200;
+  for (int k = 0; k < kTried; ++k) {
+    const auto [truth, seed] = draw(uniform, *chain, 2.0);  // up to 1 rad away on every joint
     const Pose target = chain->forward(truth);
     std::vector<double> q(6);
     const IkOutcome out = ik.solve(target, seed, q);
@@ -145,7 +143,7 @@ TEST(IkSolver, ReachesPosesFromDistantSeedsWithinTheLimits) {
   }
   // A local solver may end in a minimum at a limit, on the far side of which the pose lies; from
   // seeds this far it must still reach nearly every pose (measured: 98%).
-  std::cout << "IK from seeds up to 1 rad away: " << converged << " of " << tried << " poses solved\n";
+  std::cout << "IK from seeds up to 1 rad away: " << converged << " of " << kTried << " poses solved\n";
   EXPECT_GE(converged, 190);
 }
 

@@ -69,15 +69,16 @@ TEST(PositionServo, TheReferenceRespectsSpeedAndAccelerationAndStopsOnTheTarget)
       // never backwards.
       ASSERT_LE(arm->position_reference()[i] * std::copysign(1.0, target[i]),
                 std::fabs(target[i]) + g.max_acceleration[i] * 1e-6);
-      ASSERT_GE(speed * std::copysign(1.0, target[i]), -g.max_acceleration[i] * 1e-3) << "joint " << i << " at " << k
-                                                                                       << " ms";
+      ASSERT_GE(speed * std::copysign(1.0, target[i]), -g.max_acceleration[i] * 1e-3)
+          << "joint " << i << " at " << k << " ms";
       previous_speed[i] = speed;
       fastest = std::max(fastest, std::fabs(arm->velocities()[i]));
       worst_lag = std::max(worst_lag, std::fabs(arm->positions()[i] - arm->position_reference()[i]));
     }
   }
   std::cout << "servo: a step of up to 1.2 rad; the arm within " << worst_lag << " rad of its reference, fastest joint "
-            << fastest << " rad/s, 1.5 s later " << max_abs_difference(arm->positions(), target) << " rad from the target\n";
+            << fastest << " rad/s, 1.5 s later " << max_abs_difference(arm->positions(), target)
+            << " rad from the target\n";
   EXPECT_LT(max_abs_difference(arm->positions(), target), 1e-6);
   // The servo feeds the reference motion's inverse dynamics forward: the arm follows it closely.
   EXPECT_LT(worst_lag, 5e-4);

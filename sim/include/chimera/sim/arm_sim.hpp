@@ -159,7 +159,7 @@ class ArmSim {
   ArmSim() = default;
   void measure() noexcept;
   void servo_control() noexcept;
-  void plan_reference(std::size_t joint, double dt, bool target_moving) noexcept;
+  void plan_reference(std::size_t k, double dt, bool target_moving) noexcept;
 
   struct ModelDeleter {
     void operator()(mjModel_* m) const noexcept;
@@ -190,7 +190,7 @@ class ArmSim {
   std::vector<double> reference_;
   std::vector<double> reference_speed_;
   std::vector<double> reference_acceleration_;
-  std::vector<double> feedforward_;   // M(q) times the reference acceleration
+  std::vector<double> feedforward_;        // M(q) times the reference acceleration
   std::vector<double> reference_inertia_;  // joint-space inertia diagonal in the reference posture
 };
 

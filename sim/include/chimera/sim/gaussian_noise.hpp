@@ -25,7 +25,7 @@ class GaussianNoise {
       has_spare_ = false;
       return spare_;
     }
-    constexpr double kScale = 1.0 / 9007199254740992.0;                        // 2^-53
+    constexpr double kScale = 1.0 / 9007199254740992.0;                           // 2^-53
     const double u1 = (static_cast<double>(splitmix64() >> 11U) + 1.0) * kScale;  // (0, 1]
     const double u2 = static_cast<double>(splitmix64() >> 11U) * kScale;
     const double r = std::sqrt(-2.0 * std::log(u1));
