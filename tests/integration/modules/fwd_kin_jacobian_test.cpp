@@ -33,8 +33,9 @@ Pose sim_tool_pose(sim::ArmSim& arm, const std::vector<double>& q) {
   const sim::SitePose s = arm.site_pose(*arm.find_site("tool"));
   Pose p;
   p.position = Eigen::Vector3d(s.position[0], s.position[1], s.position[2]);
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) p.rotation(r, c) = s.rotation[static_cast<std::size_t>(3 * r + c)];
+  for (std::size_t r = 0; r < 3; ++r)
+    for (std::size_t c = 0; c < 3; ++c)
+      p.rotation(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) = s.rotation[3 * r + c];
   return p;
 }
 

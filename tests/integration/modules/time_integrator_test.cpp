@@ -36,7 +36,7 @@ TEST(TimeIntegrator, StartsAtTheArmAndIntegratesOverThePeriod) {
   auto sub = start_subsystem(kFile);
   ASSERT_NE(sub, nullptr);
   EXPECT_EQ(value_of(*sub, "theta_d"), (std::vector<double>{0.5, -1.0, 2.0}));  // on: where the arm is
-  sub->run_for(1000 * 1'000'000);  // 500 cycles of 2 ms: the release at 1 s is not run yet
+  sub->run_for(1000 * kMs);  // 500 cycles of 2 ms: the release at 1 s is not run yet
   const auto theta_d = value_of(*sub, "theta_d");
   ASSERT_EQ(theta_d.size(), 3U);
   EXPECT_NEAR(theta_d[0], 0.5 + 0.25 * 1.0, 1e-12);

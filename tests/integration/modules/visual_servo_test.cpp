@@ -176,6 +176,7 @@ tasks:
   for (int k = 0; k < 2000; ++k) {
     sub->run_for(10 * kMs);
     const auto jacobian = value_of(*sub, "jacobian");
+    ASSERT_EQ(jacobian.size(), 36U);
     const Eigen::Map<const Eigen::Matrix<double, 6, 6, Eigen::RowMajor>> j(jacobian.data());
     lowest_w = std::min(lowest_w, std::fabs(j.determinant()));
     if (k >= 200) {
