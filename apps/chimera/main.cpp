@@ -65,6 +65,11 @@ int run_main(int argc, char** argv) {
       ->capture_default_str();
   auto* run_stats_opt = run_cmd->add_option("--stats-json", run_stats, "write per-task timing figures here at exit");
 
+  chimera::cli::AnalyzeArgs analyze;
+  auto* analyze_cmd = chimera::cli::add_analyze_command(app, analyze);
+  chimera::cli::ProfileArgs profile;
+  auto* profile_cmd = chimera::cli::add_profile_command(app, profile);
+
   chimera::cli::ModulesArgs modules;
   std::string modules_name;
   auto* modules_cmd = app.add_subcommand("modules", "List the module library, or one module's ports and parameters");
@@ -102,6 +107,8 @@ int run_main(int argc, char** argv) {
     if (verify_config_opt->count() > 0) verify.config = verify_config;
     return chimera::cli::verify_command(verify);
   }
+  if (analyze_cmd->parsed()) return chimera::cli::analyze_command(analyze);
+  if (profile_cmd->parsed()) return chimera::cli::profile_command(profile);
   if (run_cmd->parsed()) {
     if (run_config_opt->count() > 0) run.config = run_config;
     if (run_for_opt->count() > 0) run.for_ns = *chimera::parse_duration_ns(run_for);

@@ -85,4 +85,60 @@ class BenchNullPid final : public Module {
   }
 };
 
+/// A producer for the switch benchmark: out-var `stamp` = the release of the cycle that wrote it.
+class BenchStamper final : public Module {
+ public:
+  static constexpr const char* kName = "bench_stamper";
+  static constexpr const char* kSummary = "benchmark: stamps each output with its release";
+  static constexpr const char* kDoc = "stamp = the nominal release of the cycle (bench only).";
+  static void declare(Declarations& d, const Params& /*p*/) {
+    d.out_var<std::int64_t>("stamp", Dim::fixed(1), "release of the cycle that wrote it, ns");
+  }
+
+ protected:
+  Status init(InitContext& ctx) override {
+    timing_ = &ctx.timing();
+    stamp_ = ctx.out<std::int64_t>("stamp");
+    return Status::ok();
+  }
+  Status cycle() override {
+    stamp_[0] = timing_->release_ns;
+    return Status::ok();
+  }
+
+ private:
+  const CycleTiming* timing_ = nullptr;
+  Out<std::int64_t> stamp_;
+};
+
+/// The staying task of the switch benchmark (the robot interface's place): counts the cycles
+/// whose input is not the stamp of its own release, i.e. whose producer's cycle was lost.
+class BenchStampCheck final : public Module {
+ public:
+  static constexpr const char* kName = "bench_stamp_check";
+  static constexpr const char* kSummary = "benchmark: counts cycles that missed their producer's value";
+  static constexpr const char* kDoc = "stale = cycles whose input stamp is not their own release (bench only).";
+  static void declare(Declarations& d, const Params& /*p*/) {
+    d.in_var<std::int64_t>("stamp", Dim::fixed(1), "stamp");
+    d.out_var<std::int64_t>("stale", Dim::fixed(1), "cycles that read another release's stamp");
+  }
+
+ protected:
+  Status init(InitContext& ctx) override {
+    timing_ = &ctx.timing();
+    stamp_ = ctx.in<std::int64_t>("stamp");
+    stale_ = ctx.out<std::int64_t>("stale");
+    return Status::ok();
+  }
+  Status cycle() override {
+    if (stamp_[0] != timing_->release_ns) ++stale_[0];
+    return Status::ok();
+  }
+
+ private:
+  const CycleTiming* timing_ = nullptr;
+  In<std::int64_t> stamp_;
+  Out<std::int64_t> stale_;
+};
+
 }  // namespace chimera::bench

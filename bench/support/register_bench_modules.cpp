@@ -5,4 +5,6 @@ namespace chimera::bench {
 CHIMERA_REGISTER_MODULE(BenchStamp);
 CHIMERA_REGISTER_MODULE(BenchIdle);
 CHIMERA_REGISTER_MODULE(BenchNullPid);
+CHIMERA_REGISTER_MODULE(BenchStamper);
+CHIMERA_REGISTER_MODULE(BenchStampCheck);
 }  // namespace chimera::bench

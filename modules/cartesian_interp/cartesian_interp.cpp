@@ -3,6 +3,8 @@
 // shortest rotation, within speed and acceleration limits, for inverse kinematics or resolved
 // rate control to follow.
 
+#include "module_docs/cartesian_interp.hpp"
+
 #include "cartesian_interp/cartesian_motion.hpp"
 #include "chimera/module/registry.hpp"
 
@@ -12,33 +14,14 @@ namespace {
 using cartesian::CartesianMotion;
 using cartesian::finite_pose;
 using cartesian::Limits;
-using cartesian::pose_of;
-using cartesian::write_pose;
+using kinematics::pose_from;
+using kinematics::write_pose;
 
 class CartesianInterp final : public Module {
  public:
   static constexpr const char* kName = "cartesian_interp";
-  static constexpr const char* kSummary = "Cartesian trajectory interpolation: x_d toward x_goal within speed limits";
-  static constexpr const char* kDoc =
-      "The *Cartesian trajectory interpolator* of the paper's Figure 6 (Cartesian teleoperation): it\n"
-      "turns a goal pose that jumps (each command of an operator, from\n"
-      "[teleop_input](teleop_input.md)) into a desired tool pose `x_d` that moves smoothly toward it,\n"
-      "for inverse kinematics (`inv_kin`) or resolved-rate control (`damped_least_squares` and\n"
-      "`time_integrator`) to follow."
-      "\n\n"
-      "Poses are [x y z rx ry rz]: m, and "
-      "a rotation vector in rad, in the arm's base frame. Turned on, x_d starts at the measured pose "
-      "x_m, at rest. Each cycle of dt it moves toward the goal x_goal: the position along the straight "
-      "line to the goal's, the orientation about the fixed axis of the shortest rotation to the "
-      "goal's, each with a speed that never exceeds speed (m/s) or angular_speed (rad/s), changes by "
-      "at most acceleration dt (m/s^2) or angular_acceleration dt (rad/s^2) per cycle, and is at most "
-      "the speed from which it can still stop exactly on the goal: at a distance d, with x = d / (a "
-      "dt^2), a dt (x / (N + 1) + N / 2) for the whole N with N (N + 1) / 2 < x <= (N + 1) (N + 2) / 2 "
-      "(a trapezoidal profile in discrete time, landing on the goal without overshoot). A goal that moves "
-      "is followed the same way, the velocity turning within the acceleration limits. dx_d is the "
-      "velocity [v; w]. While x_goal has no data or is not finite (NaN: no goal yet), x_d holds. "
-      "Defaults: speed 0.25 m/s, acceleration 1 m/s^2, angular_speed 1 rad/s, angular_acceleration 4 "
-      "rad/s^2. The task must be periodic. See docs/modules/cartesian_interp.md.";
+  static constexpr const char* kSummary = docs::cartesian_interp::kSummary;
+  static constexpr const char* kDoc = docs::cartesian_interp::kText;
 
   static void declare(Declarations& d, const Params& /*params*/) {
     d.in_var("x_goal", Dim::fixed(6), "goal tool pose [x y z rx ry rz], m and rad (NaN: none yet)");
@@ -82,7 +65,7 @@ class CartesianInterp final : public Module {
   Status cycle() override {
     if (!started_ && !start_from_measurement()) return Status::ok();
     const bool has_goal = x_goal_.has_data() && finite_pose(x_goal_.values());
-    motion_.step(has_goal ? pose_of(x_goal_.values()) : motion_.pose(), limits_, dt_);
+    motion_.step(has_goal ? pose_from(x_goal_.values()) : motion_.pose(), limits_, dt_);
     publish();
     return Status::ok();
   }
@@ -91,7 +74,7 @@ class CartesianInterp final : public Module {
   // Where the tool is, at rest; false while nothing has measured it.
   bool start_from_measurement() noexcept {
     if (!x_m_.has_data() || !finite_pose(x_m_.values())) return false;
-    motion_.reset(pose_of(x_m_.values()));
+    motion_.reset(pose_from(x_m_.values()));
     publish();
     started_ = true;
     return true;

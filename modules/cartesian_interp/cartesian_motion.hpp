@@ -2,68 +2,41 @@
 // Cartesian trajectory interpolation: a tool pose that moves toward a goal pose, which may itself
 // move, along a straight line for the position and the shortest rotation for the orientation,
 // each no faster and accelerating no harder than its limits, stopping on the goal without
-// overshoot. Poses are 6 numbers [x y z rx ry rz] as the kinematics modules exchange them: the
-// position (m) and a rotation vector (rad), both in the arm's base frame.
+// overshoot. Poses are those of kinematics/pose.hpp: 6 numbers [x y z rx ry rz], the position (m)
+// and a rotation vector (rad), both in the arm's base frame.
 //
 // Fixed-size Eigen types only: no allocation; everything here is real-time safe.
 
 #include <algorithm>
 #include <cmath>
-#include <cstddef>
 #include <span>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "kinematics/pose.hpp"
+
 namespace chimera::modules::cartesian {
 
 using Vec3 = Eigen::Vector3d;
-using Mat3 = Eigen::Matrix3d;
-
-/// Rotation of rotation vector r (Rodrigues).
-inline Mat3 rotation_of(const Vec3& r) noexcept {
-  const double angle = r.norm();
-  if (angle < 1e-300) return Mat3::Identity();
-  return Eigen::AngleAxisd(angle, r / angle).toRotationMatrix();
-}
-
-/// Rotation vector of R, angle in [0, pi] (through a quaternion: accurate near 0 and pi).
-inline Vec3 vector_of(const Mat3& rotation) noexcept {
-  const Eigen::AngleAxisd aa(Eigen::Quaterniond(rotation).normalized());
-  return aa.angle() * aa.axis();
-}
-
-struct Pose {
-  Vec3 position = Vec3::Zero();
-  Mat3 rotation = Mat3::Identity();
-};
-
-/// The pose of 6 numbers [x y z rx ry rz]; x has 6 elements.
-inline Pose pose_of(std::span<const double> x) noexcept {
-  return Pose{Vec3(x[0], x[1], x[2]), rotation_of(Vec3(x[3], x[4], x[5]))};
-}
-
-/// Writes `pose` as 6 numbers; x has 6 elements.
-inline void write_pose(const Pose& pose, std::span<double> x) noexcept {
-  const Vec3 r = vector_of(pose.rotation);
-  for (Eigen::Index i = 0; i < 3; ++i) {
-    x[static_cast<std::size_t>(i)] = pose.position[i];
-    x[static_cast<std::size_t>(i) + 3] = r[i];
-  }
-}
+using kinematics::Pose;
 
 /// Whether all 6 numbers are finite: a pose that is NaN means "none yet".
 inline bool finite_pose(std::span<const double> x) noexcept {
   return x.size() == 6 && std::all_of(x.begin(), x.end(), [](double v) { return std::isfinite(v); });
 }
 
-/// `pose` moved by d = [dp; dr]: position + dp, orientation turned by dr about the base axes.
+/// `pose` moved by dp and turned by the rotation vector dr about the base axes.
 inline Pose displaced(const Pose& pose, const Vec3& dp, const Vec3& dr) noexcept {
-  return Pose{pose.position + dp, rotation_of(dr) * pose.rotation};
+  kinematics::Vector6 d;
+  d << dp, dr;
+  return kinematics::displace(pose, d);
 }
 
 /// The rotation (about the base axes) that turns `from` into `to`, as a rotation vector.
-inline Vec3 rotation_error(const Mat3& to, const Mat3& from) noexcept { return vector_of(to * from.transpose()); }
+inline Vec3 rotation_error(const Eigen::Matrix3d& to, const Eigen::Matrix3d& from) noexcept {
+  return kinematics::rotation_vector(to * from.transpose());
+}
 
 /// The fastest speed toward a point `distance` away from which a body whose speed may fall by
 /// at most `accel` dt each step of dt still stops exactly on it. Moving at s, s - a dt, ...,
@@ -122,9 +95,8 @@ class CartesianMotion {
     const Vec3 turn = step_toward(rotation_error(goal.rotation, pose_.rotation), angular_velocity_,
                                   limits.angular_speed, limits.angular_acceleration, dt, arrived);
     // Through a unit quaternion: the product of many small turns stays a rotation.
-    pose_.rotation = arrived
-                         ? goal.rotation
-                         : Mat3(Eigen::Quaterniond(rotation_of(turn) * pose_.rotation).normalized().toRotationMatrix());
+    const Eigen::Quaterniond turned(kinematics::rotation_from_vector(turn) * pose_.rotation);
+    pose_.rotation = arrived ? goal.rotation : Eigen::Matrix3d(turned.normalized().toRotationMatrix());
   }
 
   [[nodiscard]] const Pose& pose() const noexcept { return pose_; }

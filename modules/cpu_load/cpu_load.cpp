@@ -1,6 +1,8 @@
 // cpu_load: a task that only takes time. For what-if studies and schedulability experiments on
 // either clock, for benchmarks (many trivial tasks), and for injecting timing failures.
 
+#include "module_docs/cpu_load.hpp"
+
 #include <cmath>
 #include <cstdint>
 
@@ -15,16 +17,8 @@ std::int64_t ns_of(double seconds) { return static_cast<std::int64_t>(std::llrou
 class CpuLoad final : public Module {
  public:
   static constexpr const char* kName = "cpu_load";
-  static constexpr const char* kSummary = "Takes a set execution time each cycle; can overrun on purpose";
-  static constexpr const char* kDoc =
-      "A task that only takes time: each cycle lasts `exec` seconds, and every `overrun_every`-th "
-      "cycle lasts `overrun` seconds longer. On the real clock it busy-waits on the monotonic clock "
-      "(real CPU time, so the scheduler sees real load); on the virtual clock it charges the time as "
-      "simulated execution (Module::consume_virtual_time), so runs repeat exactly. With a `wcet` on "
-      "its task, the overruns are timing failures the framework detects; `recover` makes its "
-      "error() recover from timing failures (otherwise a hard task goes to ERROR at the first). "
-      "Parameters: exec (s, default 0), overrun_every (cycles, default 0: never), overrun (s, "
-      "default 0), recover (default false). No ports. See docs/modules/cpu_load.md.";
+  static constexpr const char* kSummary = docs::cpu_load::kSummary;
+  static constexpr const char* kDoc = docs::cpu_load::kText;
 
   static void declare(Declarations& d, const Params&) {
     d.param("exec", 0.0, "s", "execution time of each cycle");

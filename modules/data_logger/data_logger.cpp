@@ -2,6 +2,8 @@
 // output ports. Each cycle copies the chosen variables into a preallocated ring; an ordinary
 // thread drains the ring into a CSV file, so the real-time path never formats, writes or waits.
 
+#include "module_docs/data_logger.hpp"
+
 #include <pthread.h>
 #include <sched.h>
 #include <unistd.h>
@@ -29,6 +31,7 @@
 
 #include "chimera/module/registry.hpp"
 #include "row_ring.hpp"
+#include "support/module_support.hpp"
 
 namespace chimera::modules {
 namespace {
@@ -71,25 +74,8 @@ void become_ordinary_thread() {
 class DataLogger final : public Module {
  public:
   static constexpr const char* kName = "data_logger";
-  static constexpr const char* kSummary = "records chosen state variables to a CSV file (no outputs)";
-  static constexpr const char* kDoc =
-      "The paper's *data logger* (section 3): a task that \"just gathers data\" and so has no output\n"
-      "ports. It records the variables it is given, every cycle, to a CSV file, without ever making\n"
-      "its real-time cycle wait, format or write: a ring allocated at init takes the rows, and an\n"
-      "ordinary thread writes them out."
-      "\n\n"
-      "One in-var port for each name in "
-      "variables (a port takes the size its variable has elsewhere in the file; rename: binds a port "
-      "to another variable). Each cycle it copies the release time t (s, on the subsystem's clock) "
-      "and every element of every variable (nan before the variable has data) into a preallocated "
-      "ring of capacity rows (0: one second's worth at the task's period, at least 1024). An ordinary "
-      "thread drains the ring every 20 ms into the CSV file (default <task>.csv; a relative path goes "
-      "below $CHIMERA_LOG_DIR when it is set): a header t,name[0],name[1],... (a one-element variable "
-      "is just name), then one row a cycle, each number in its shortest exact form. The cycle never "
-      "waits, formats or writes: when the ring is full on the real clock the row is dropped and "
-      "counted (reported when the task is killed); on the virtual clock the cycle waits for room, so "
-      "a virtual run's log is complete and the same run after run. `chimera plot FILE.csv -o "
-      "FILE.png` draws a log. See docs/modules/data_logger.md.";
+  static constexpr const char* kSummary = docs::data_logger::kSummary;
+  static constexpr const char* kDoc = docs::data_logger::kText;
 
   static void declare(Declarations& d, const Params& p) {
     for (const auto& v : variables_of(p)) d.in_var(v, Dim::follow(), "recorded, every element each cycle");
@@ -131,10 +117,9 @@ class DataLogger final : public Module {
     path_ = log_path(p, ctx.task_name());
     task_ = std::string(ctx.task_name());
     file_ = std::fopen(path_.c_str(), "w");
-    if (file_ == nullptr) {
-      spdlog::error("{}: cannot write the log {}: {}", task_, path_, std::generic_category().message(errno));
-      return Status::fail("cannot open the log file (param file) for writing");
-    }
+    if (file_ == nullptr)
+      return Status::fail(
+          intern(fmt::format("cannot write the log {}: {}", path_, std::generic_category().message(errno))));
     out_.reserve(kWriteChunk + 4096);
     write_header();
     timing_ = &ctx.timing();

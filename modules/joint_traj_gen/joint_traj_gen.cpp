@@ -1,5 +1,7 @@
 // joint_traj_gen: the joint position trajectory generator of the paper's Figure 4.
 
+#include "module_docs/joint_traj_gen.hpp"
+
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -22,20 +24,8 @@ Matrix default_via() {
 class JointTrajGen final : public Module {
  public:
   static constexpr const char* kName = "joint_traj_gen";
-  static constexpr const char* kSummary = "Joint position trajectory generator: quintic moves through via points";
-  static constexpr const char* kDoc =
-      "The joint position trajectory generator of the paper's Figure 4. When turned on it starts "
-      "from the measured joint positions theta_m (zeros if no task has written them) and moves "
-      "through the via points one after another: each move is a quintic polynomial in time, "
-      "theta_d(t) = a + (b - a) s(u), s(u) = 10u^3 - 15u^4 + 6u^5, u = t / segment_time, so the "
-      "velocity and acceleration are zero at every via point (Craig 1989, Introduction to Robotics, "
-      "7.3); it then rests hold_time at the via point. With loop it goes on from the last via point "
-      "back to the first, forever; without, it stays at the last one. Outputs: theta_d (rad) and "
-      "dtheta_d = (b - a) s'(u) / segment_time (rad/s). Time is the number of cycles since on times "
-      "the period, so the motion is exact and repeatable on the virtual clock. Parameters: via "
-      "(rad, a list of joint vectors of ndof entries each; default 3 points moving all 6 joints of "
-      "the shipped arm), segment_time (s, default 1.5), hold_time (s, default 0.3), loop (default "
-      "true). The task must be periodic. See docs/modules/joint_traj_gen.md.";
+  static constexpr const char* kSummary = docs::joint_traj_gen::kSummary;
+  static constexpr const char* kDoc = docs::joint_traj_gen::kText;
 
   static void declare(Declarations& d, const Params& /*params*/) {
     d.in_const("ndof", Dim::fixed(1), "degrees of freedom");

@@ -1,5 +1,7 @@
 // pid_joint: the PID joint position controller of the paper's Figure 4.
 
+#include "module_docs/pid_joint.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -8,6 +10,7 @@
 #include "chimera/module/fault_tolerance.hpp"
 #include "chimera/module/registry.hpp"
 #include "pid_law.hpp"
+#include "support/module_support.hpp"
 
 namespace chimera::modules {
 namespace {
@@ -20,35 +23,13 @@ Vector default_kd() { return {150, 200, 100, 20, 20, 15}; }
 Vector default_tau_max() { return {150, 150, 80, 20, 20, 20}; }
 Vector default_i_max() { return {0.05, 0.05, 0.05, 0.05, 0.05, 0.05}; }
 
-// A per-joint parameter: ndof entries, or one for every joint. Empty on a wrong length.
-Vector per_joint(const Params& p, std::string_view name, Vector fallback, std::size_t n) {
-  Vector v = p.vector(name, std::move(fallback));
-  if (v.size() == 1) v.assign(n, v[0]);
-  if (v.size() != n) v.clear();
-  for (double x : v)
-    if (!std::isfinite(x) || x < 0.0) v.clear();
-  return v;
-}
-
 constexpr double kDefaultLateLimit = 100;
 
 class PidJoint final : public Module {
  public:
   static constexpr const char* kName = "pid_joint";
-  static constexpr const char* kSummary = "PID joint position controller: joint torques from position errors";
-  static constexpr const char* kDoc =
-      "The PID joint position controller of the paper's Figure 4: an independent PID loop per joint "
-      "(Craig 1989, Introduction to Robotics, 9 and 10.7). With e = theta_d - theta_m it outputs "
-      "tau_r = kp e + ki int(e) dt + kd (dtheta_d - dtheta_m), saturated to +-tau_max. The integral "
-      "is summed once a cycle (dt = the task's period), kept within +-i_max, and frozen for a joint "
-      "whose output is saturated in the direction of its error (anti-windup by conditional "
-      "integration); on resets it to zero. While any input has not been written yet the output is "
-      "zero torque. No gravity feed-forward: the integral term holds the arm against gravity, as in "
-      "the paper's controller. Parameters, each a list of ndof values or a single value for every "
-      "joint: kp (N*m/rad, default 2500 4000 2500 400 400 300), ki (N*m/(rad*s), default 2500 5000 "
-      "2500 300 300 200), kd (N*m*s/rad, default 150 200 100 20 20 15), tau_max (N*m, default 150 "
-      "150 80 20 20 20, the shipped arm's limits), i_max (rad*s, default 0.05). The defaults are "
-      "tuned for the shipped arm at 1 kHz. See docs/modules/pid_joint.md.";
+  static constexpr const char* kSummary = docs::pid_joint::kSummary;
+  static constexpr const char* kDoc = docs::pid_joint::kText;
 
   static void declare(Declarations& d, const Params& /*params*/) {
     d.in_const("ndof", Dim::fixed(1), "degrees of freedom");
@@ -88,8 +69,10 @@ class PidJoint final : public Module {
     g.kd = per_joint(p, "kd", default_kd(), n);
     g.tau_max = per_joint(p, "tau_max", default_tau_max(), n);
     g.i_max = per_joint(p, "i_max", default_i_max(), n);
-    if (g.kp.empty() || g.ki.empty() || g.kd.empty() || g.tau_max.empty() || g.i_max.empty())
-      return Status::fail("pid_joint: kp, ki, kd, tau_max and i_max need ndof (or 1) values, none negative");
+    const bool valid = !g.kp.empty() && !g.ki.empty() && !g.kd.empty() && !g.tau_max.empty() && !g.i_max.empty() &&
+                       all_non_negative(g.kp) && all_non_negative(g.ki) && all_non_negative(g.kd) &&
+                       all_non_negative(g.tau_max) && all_non_negative(g.i_max);
+    if (!valid) return Status::fail("pid_joint: kp, ki, kd, tau_max and i_max need ndof (or 1) values, none negative");
     law_.configure(std::move(g), dt);
     timing_ = &ctx.timing();
     tolerance_ =

@@ -3,6 +3,8 @@
 // from its command line, the keyboard or a recording, or replays a recorded session on the
 // subsystem's clock; it turns them into the goal pose x_goal that cartesian_interp follows.
 
+#include "module_docs/teleop_input.hpp"
+
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -16,11 +18,10 @@
 #include <string_view>
 #include <vector>
 
-#include <spdlog/spdlog.h>
-
 #include "cartesian_interp/cartesian_motion.hpp"
 #include "chimera/module/registry.hpp"
-#include "net/udp_socket.hpp"
+#include "support/module_support.hpp"
+#include "support/udp_socket.hpp"
 #include "teleop_command.hpp"
 
 namespace chimera::modules {
@@ -28,8 +29,8 @@ namespace {
 
 using cartesian::finite_pose;
 using cartesian::Pose;
-using cartesian::pose_of;
 using cartesian::Vec3;
+using kinematics::pose_from;
 using teleop::Command;
 using teleop::Verb;
 
@@ -61,27 +62,8 @@ bool skipped(std::string_view line) {
 class TeleopInput final : public Module {
  public:
   static constexpr const char* kName = "teleop_input";
-  static constexpr const char* kSummary = "Teleoperation input: operator commands (UDP or a recording) to a goal pose";
-  static constexpr const char* kDoc =
-      "The *teleoperation input* of the paper's Figure 6 (Cartesian teleoperation). Its **resource\n"
-      "port** takes an operator's commands, from UDP datagrams (sent by `chimera-teleop` from its\n"
-      "command line, the keyboard or a recording) or from a recorded session replayed on the\n"
-      "subsystem's clock, and turns them into the goal pose `x_goal` that\n"
-      "[cartesian_interp](cartesian_interp.md) moves the tool toward."
-      "\n\n"
-      "Commands, one a line: `move dx dy dz [drx dry drz]` steps the goal (m; rad about the base "
-      "axes), `goto x y z rx ry rz` sets it, `vel vx vy vz [wx wy wz]` moves it at that velocity (m/s, "
-      "rad/s) until `stop`, another command, or timeout seconds without a command (a dead man's "
-      "switch), `hold` puts it where the tool is (x_m), `home` where the tool was at the first cycle. "
-      "With source udp the commands are UDP datagrams (one or more lines each) on address:port, read "
-      "without blocking, at most 32 a cycle (scripts/chimera-teleop sends them from its command line, "
-      "the keyboard or a recording); with source replay they come from a recorded session, lines "
-      "`seconds command` (session, or the file record), each carried out at the first cycle at least "
-      "that long after the task was turned on, on the subsystem's clock: deterministic on the virtual "
-      "clock. The goal starts at the measured pose x_m at the first cycle that has it (x_goal is NaN "
-      "until then, and commands are refused); its position stays within max_distance (m, 0: no limit) "
-      "of that start. Out-vars: x_goal [x y z rx ry rz] (m, rotation vector in rad), teleop_stats = "
-      "[commands accepted, commands refused, UDP port bound]. See docs/modules/teleop_input.md.";
+  static constexpr const char* kSummary = docs::teleop_input::kSummary;
+  static constexpr const char* kDoc = docs::teleop_input::kText;
 
   static void declare(Declarations& d, const Params& /*params*/) {
     d.in_var("x_m", Dim::fixed(6), "measured tool pose [x y z rx ry rz], m and rad");
@@ -115,7 +97,7 @@ class TeleopInput final : public Module {
 
     const std::string source = p.text("source", "udp");
     if (source == "udp") return open_socket(p);
-    if (source == "replay") return load_session(p, ctx.task_name());
+    if (source == "replay") return load_session(p);
     return Status::fail("teleop_input: source must be udp or replay");
   }
 
@@ -131,7 +113,7 @@ class TeleopInput final : public Module {
   Status cycle() override {
     const std::int64_t now = timing_->release_ns;
     if (!started_ && x_m_.has_data() && finite_pose(x_m_.values())) {
-      origin_ = goal_ = pose_of(x_m_.values());
+      origin_ = goal_ = pose_from(x_m_.values());
       started_ = true;
     }
     if (fd_ >= 0) receive(now);
@@ -140,7 +122,7 @@ class TeleopInput final : public Module {
     if (moving_) goal_ = cartesian::displaced(goal_, velocity_ * dt_, angular_velocity_ * dt_);
     if (started_) {
       keep_within_reach();
-      cartesian::write_pose(goal_, x_goal_.values());
+      kinematics::write_pose(goal_, x_goal_.values());
     }
     stats_[0] = static_cast<double>(accepted_);
     stats_[1] = static_cast<double>(refused_);
@@ -156,30 +138,25 @@ class TeleopInput final : public Module {
 
  private:
   Status open_socket(const Params& p) {
-    const net::UdpSocket socket = net::bind_udp(p.text("address", "127.0.0.1"), p.number("port", 0.0));
+    const UdpSocket socket = bind_udp(p.text("address", "127.0.0.1"), p.number("port", 0.0));
     if (socket.fd < 0) return Status::fail(socket.error);
     fd_ = socket.fd;
     port_ = socket.port;
     return Status::ok();
   }
 
-  Status load_session(const Params& p, std::string_view task) {
+  Status load_session(const Params& p) {
     std::vector<std::string> lines = p.strings("session");
     if (const std::string file = p.text("record"); !file.empty()) {
       std::ifstream in(file);
-      if (!in) {
-        spdlog::error("{}: cannot read the recorded session {}", task, file);
-        return Status::fail("teleop_input: cannot read the record file");
-      }
+      if (!in) return Status::fail(intern("teleop_input: cannot read the record file " + file));
       for (std::string line; std::getline(in, line);) lines.push_back(line);
     }
     for (const auto& line : lines) {
       if (skipped(line)) continue;
       TimedCommand c;
-      if (!parse_timed(line, c)) {
-        spdlog::error("{}: \"{}\" is not `seconds command` (e.g. 1.5 move 0.05 0 0)", task, line);
-        return Status::fail("teleop_input: a recorded command is not `seconds command`");
-      }
+      if (!parse_timed(line, c))
+        return Status::fail(intern("teleop_input: \"" + line + "\" is not `seconds command` (e.g. 1.5 move 0.05 0 0)"));
       if (!session_.empty() && c.at_ns < session_.back().at_ns)
         return Status::fail("teleop_input: the recorded commands must be in time order");
       session_.push_back(c);
@@ -221,7 +198,7 @@ class TeleopInput final : public Module {
     moving_ = false;
     switch (c.verb) {
       case Verb::kMove: goal_ = cartesian::displaced(goal_, linear, angular); break;
-      case Verb::kGoto: goal_ = pose_of(v); break;
+      case Verb::kGoto: goal_ = pose_from(v); break;
       case Verb::kVel:
         velocity_ = linear;
         angular_velocity_ = angular;
@@ -229,7 +206,7 @@ class TeleopInput final : public Module {
         break;
       case Verb::kStop: break;
       case Verb::kHold:
-        if (x_m_.has_data() && finite_pose(x_m_.values())) goal_ = pose_of(x_m_.values());
+        if (x_m_.has_data() && finite_pose(x_m_.values())) goal_ = pose_from(x_m_.values());
         break;
       case Verb::kHome: goal_ = origin_; break;
     }

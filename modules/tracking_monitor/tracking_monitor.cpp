@@ -1,5 +1,7 @@
 // tracking_monitor: watches how well measured joint positions follow the desired ones.
 
+#include "module_docs/tracking_monitor.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -11,14 +13,8 @@ namespace {
 class TrackingMonitor final : public Module {
  public:
   static constexpr const char* kName = "tracking_monitor";
-  static constexpr const char* kSummary = "joint tracking error of a controller: now, RMS and worst since on";
-  static constexpr const char* kDoc =
-      "Compares desired and measured joint positions each cycle. With e_i = theta_d_i - theta_m_i "
-      "it publishes tracking_error = [max_i |e_i| now, RMS over joints and cycles since on, "
-      "worst max_i |e_i| since on], in rad. The RMS and the worst value ignore the first "
-      "settle_time seconds after on (s, default 0.5), while the arm is pulled onto the trajectory. "
-      "A monitor task: its output feeds no controller, so adding it to a configuration changes "
-      "nothing else. See docs/modules/tracking_monitor.md.";
+  static constexpr const char* kSummary = docs::tracking_monitor::kSummary;
+  static constexpr const char* kDoc = docs::tracking_monitor::kText;
 
   static void declare(Declarations& d, const Params& /*params*/) {
     d.in_const("ndof", Dim::fixed(1), "degrees of freedom");

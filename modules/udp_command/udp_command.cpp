@@ -3,6 +3,8 @@
 // publishes the numbers it holds. Run it under a sporadic server (`server:` in the file) so that
 // a flood of datagrams can never take more than its share of the processor.
 
+#include "module_docs/udp_command.hpp"
+
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -14,7 +16,7 @@
 #include <string>
 
 #include "chimera/module/registry.hpp"
-#include "net/udp_socket.hpp"
+#include "support/udp_socket.hpp"
 
 namespace chimera::modules {
 namespace {
@@ -31,18 +33,8 @@ std::uint32_t size_of(const Params& p) {
 class UdpCommand final : public Module {
  public:
   static constexpr const char* kName = "udp_command";
-  static constexpr const char* kSummary = "Aperiodic UDP command receiver: each datagram of numbers becomes a variable";
-  static constexpr const char* kDoc =
-      "An aperiodic task (give it no period, and a `server:` to bound its share of the processor) "
-      "whose resource port is a UDP socket bound to address:port. Each datagram is one event: when "
-      "the socket is readable the framework calls sync(), which takes one datagram without "
-      "blocking, then cycle(), which parses it as `size` numbers separated by blanks (text, e.g. "
-      "\"0.5 0 0.3 0 0 0\") and publishes them on out-var `command`; a datagram that is not exactly "
-      "`size` numbers is counted as rejected and changes nothing. Out-vars: command[size], "
-      "command_stats[2] = [datagrams accepted, datagrams rejected], udp_port[1] = the port bound "
-      "(useful with port 0, which lets the system choose). Parameters: address (default "
-      "\"127.0.0.1\"), port (default 0), size (default 6, at most 256), cost (s, default 0: "
-      "simulated time each datagram takes on the virtual clock). See docs/modules/udp_command.md.";
+  static constexpr const char* kSummary = docs::udp_command::kSummary;
+  static constexpr const char* kDoc = docs::udp_command::kText;
 
   static void declare(Declarations& d, const Params& p) {
     const std::uint32_t n = size_of(p);
@@ -66,7 +58,7 @@ class UdpCommand final : public Module {
     if (!(cost >= 0)) return Status::fail("udp_command: cost must be >= 0 s");
     cost_ns_ = static_cast<std::int64_t>(std::llround(cost * 1e9));
 
-    const net::UdpSocket socket = net::bind_udp(p.text("address", "127.0.0.1"), p.number("port"));
+    const UdpSocket socket = bind_udp(p.text("address", "127.0.0.1"), p.number("port"));
     if (socket.fd < 0) return Status::fail(socket.error);
     fd_ = socket.fd;
 

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <limits>
 #include <numbers>
 #include <system_error>
 
@@ -38,13 +39,6 @@ Result<void> check_layout(const mjModel* m, const std::string& path) {
       return fail("joint " + std::to_string(i) + " must be a hinge or a slide");
   }
   return {};
-}
-
-constexpr std::uint64_t splitmix64(std::uint64_t& state) noexcept {
-  std::uint64_t z = (state += 0x9E3779B97F4A7C15ULL);
-  z = (z ^ (z >> 30U)) * 0xBF58476D1CE4E5B9ULL;
-  z = (z ^ (z >> 27U)) * 0x94D049BB133111EBULL;
-  return z ^ (z >> 31U);
 }
 
 }  // namespace
@@ -131,8 +125,20 @@ Result<std::unique_ptr<ArmSim>> ArmSim::load(std::string_view path, SensorNoise 
   // Sized once here: the real-time calls only overwrite them.
   sim->q_meas_.assign(n, 0.0);
   sim->qd_meas_.assign(n, 0.0);
+  for (auto* v : {&sim->target_, &sim->target_speed_, &sim->reference_, &sim->reference_speed_,
+                  &sim->reference_acceleration_, &sim->feedforward_})
+    v->assign(n, 0.0);
   sim->noise_ = noise;
   sim->reset();
+  // The servo's default gains come from each joint's inertia in the model's reference posture.
+  std::vector<mjtNum> inertia(n * n);
+  mj_fullM(m, inertia.data(), sim->data_->qM);
+  sim->reference_inertia_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto dof = static_cast<std::size_t>(sim->dof_adr_[i]);
+    sim->reference_inertia_[i] = inertia[dof * n + dof];
+  }
+  sim->gains_ = sim->servo_gains(kDefaultServoBandwidthHz, kDefaultServoMaxSpeed);
   return sim;
 }
 
@@ -158,6 +164,124 @@ double ArmSim::torque_max(int i) const noexcept {
   return m->actuator_ctrllimited[i] != 0 ? m->actuator_ctrlrange[2 * static_cast<std::ptrdiff_t>(i) + 1] : mjMAXVAL;
 }
 
+double ArmSim::joint_min(int i) const noexcept {
+  const mjModel* m = model_.get();
+  return m->jnt_limited[i] != 0 ? m->jnt_range[2 * static_cast<std::ptrdiff_t>(i)]
+                                : -std::numeric_limits<double>::infinity();
+}
+
+double ArmSim::joint_max(int i) const noexcept {
+  const mjModel* m = model_.get();
+  return m->jnt_limited[i] != 0 ? m->jnt_range[2 * static_cast<std::ptrdiff_t>(i) + 1]
+                                : std::numeric_limits<double>::infinity();
+}
+
+void ArmSim::set_drive(Drive drive) noexcept {
+  if (drive == Drive::kPosition && drive_ != Drive::kPosition) hold();
+  drive_ = drive;
+}
+
+void ArmSim::set_position_target(std::span<const double> q) noexcept {
+  // Successive targets a period apart give the target's speed, used until the next one is due.
+  // A change faster than max_speed is a jump to go to, not a motion to follow.
+  const std::int64_t elapsed_steps = std::max<std::int64_t>(steps_ - target_step_, 1);
+  const double elapsed = static_cast<double>(elapsed_steps) * model_->opt.timestep;
+  target_interval_ = elapsed_steps;
+  target_step_ = steps_;
+  for (int i = 0; i < ndof_; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    if (k >= q.size() || std::isnan(q[k])) {
+      target_speed_[k] = 0.0;
+      continue;
+    }
+    const double next = std::clamp(q[k], joint_min(i), joint_max(i));
+    const double speed = (next - target_[k]) / elapsed;
+    target_speed_[k] = std::fabs(speed) <= gains_.max_speed[k] ? speed : 0.0;
+    target_[k] = next;
+  }
+}
+
+ServoGains ArmSim::servo_gains(double bandwidth_hz, double max_speed) const {
+  const double w = 2.0 * std::numbers::pi * bandwidth_hz;
+  ServoGains g;
+  for (std::size_t i = 0; i < reference_inertia_.size(); ++i) {
+    const double inertia = reference_inertia_[i];
+    g.kp.push_back(inertia * w * w);
+    g.kd.push_back(2.0 * inertia * w);
+    g.max_speed.push_back(max_speed);
+    const double torque = std::min(torque_max(static_cast<int>(i)), -torque_min(static_cast<int>(i)));
+    g.max_acceleration.push_back(0.5 * torque / inertia);
+  }
+  return g;
+}
+
+Result<void> ArmSim::set_servo_gains(ServoGains gains) {
+  const auto n = static_cast<std::size_t>(ndof_);
+  if (gains.kp.size() != n || gains.kd.size() != n || gains.max_speed.size() != n || gains.max_acceleration.size() != n)
+    return make_error(Errc::kInvalidInput,
+                      "servo gains need " + std::to_string(n) + " entries each (kp, kd, max_speed, max_acceleration)");
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!(gains.kp[i] >= 0.0) || !(gains.kd[i] >= 0.0) || !std::isfinite(gains.kp[i]) || !std::isfinite(gains.kd[i]))
+      return make_error(Errc::kInvalidInput, "servo gains kp and kd must be finite and >= 0");
+    if (!(gains.max_speed[i] > 0.0) || !(gains.max_acceleration[i] > 0.0))
+      return make_error(Errc::kInvalidInput, "servo max_speed and max_acceleration must be > 0");
+  }
+  gains_ = std::move(gains);
+  return {};
+}
+
+// The servo's reference stops where the arm is, and its target with it.
+void ArmSim::hold() noexcept {
+  const mjData* d = data_.get();
+  for (std::size_t i = 0; i < reference_.size(); ++i) {
+    reference_[i] = d->qpos[qpos_adr_[i]];
+    target_[i] = reference_[i];
+    target_speed_[i] = 0.0;
+    reference_speed_[i] = 0.0;
+    reference_acceleration_[i] = 0.0;
+  }
+  target_step_ = steps_;
+  target_interval_ = 1;
+}
+
+// The reference's next step toward a target moving at speed u: the speed from which it can still
+// stop on the target at max_acceleration a, on top of u, approached at no more than a, within
+// +-max_speed. In discrete time, from speed N a dt the reference covers a dt^2 N (N + 1) / 2 while
+// it stops, hence N below; and it never asks for more than reaches the target in this step.
+// The acceleration is applied after this step's torque: semi-implicit Euler, as MuJoCo integrates
+// the arm itself, so that a perfect model puts the arm on the next reference exactly.
+void ArmSim::plan_reference(std::size_t k, double dt, bool target_moving) noexcept {
+  const double e = target_[k] - reference_[k];
+  const double a = gains_.max_acceleration[k];
+  const double n = 0.5 * (std::sqrt(1.0 + 8.0 * std::fabs(e) / (a * dt * dt)) - 1.0);
+  const double approach = std::min(n * a * dt, std::fabs(e) / dt);
+  const double u = target_moving ? target_speed_[k] : 0.0;
+  const double wanted = std::clamp(u + std::copysign(approach, e), -gains_.max_speed[k], gains_.max_speed[k]);
+  reference_acceleration_[k] = std::clamp(wanted - reference_speed_[k], -a * dt, a * dt) / dt;
+}
+
+// One sample of the arm's own position servo, between mj_step1 (which computed the inertia,
+// bias and passive forces of this state) and mj_step2.
+void ArmSim::servo_control() noexcept {
+  const mjModel* m = model_.get();
+  mjData* d = data_.get();
+  const double dt = m->opt.timestep;
+  // A target not renewed when the next one was due has stopped moving.
+  const bool target_moving = steps_ - target_step_ < target_interval_;
+  for (std::size_t k = 0; k < reference_.size(); ++k) plan_reference(k, dt, target_moving);
+  mj_mulM(m, d, feedforward_.data(), reference_acceleration_.data());
+  for (int i = 0; i < ndof_; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const int dof = dof_adr_[k];
+    const double dynamics = feedforward_[static_cast<std::size_t>(dof)] + d->qfrc_bias[dof] - d->qfrc_passive[dof];
+    const double tau = dynamics + gains_.kp[k] * (reference_[k] - d->qpos[qpos_adr_[k]]) +
+                       gains_.kd[k] * (reference_speed_[k] - d->qvel[dof]);
+    d->ctrl[i] = std::clamp(tau, torque_min(i), torque_max(i));
+    reference_speed_[k] += reference_acceleration_[k] * dt;
+    reference_[k] += reference_speed_[k] * dt;
+  }
+}
+
 void ArmSim::step(std::int64_t dt_ns) noexcept {
   if (dt_ns <= 0) return;
   // A 1.5 ms period on a 1 ms model alternates 1 and 2 steps: the carry is what keeps the sum.
@@ -167,7 +291,15 @@ void ArmSim::step(std::int64_t dt_ns) noexcept {
   const mjModel* m = model_.get();
   mjData* d = data_.get();
   for (std::int64_t k = 0; k < n; ++k) {
-    mj_step(m, d);
+    if (drive_ == Drive::kPosition) {
+      // MuJoCo's split step: the state-dependent terms at this instant, then the servo's torque
+      // from them, then integration (with the Euler integrator the same as mj_step).
+      mj_step1(m, d);
+      servo_control();
+      mj_step2(m, d);
+    } else {
+      mj_step(m, d);
+    }
     ++steps_;
     // MuJoCo sums timesteps in floating point; keep its clock on the exact integer one.
     d->time = time_s();
@@ -194,6 +326,7 @@ void ArmSim::set_state(std::span<const double> q, std::span<const double> qd) no
   // A fresh state must not inherit the previous solver warm start (determinism after a jump).
   mju_zero(d->qacc_warmstart, m->nv);
   mj_forward(m, d);
+  hold();  // a servo in position mode holds the arm where it was put, not where it was
   measure();
 }
 
@@ -202,14 +335,31 @@ void ArmSim::reset() noexcept {
   steps_ = 0;
   carry_ns_ = 0;
   // The noise restarts too, so a reset run repeats the first one exactly.
-  rng_ = noise_.seed;
-  has_spare_ = false;
+  gaussian_.reseed(noise_.seed);
   mj_forward(model_.get(), data_.get());
+  hold();
   measure();
 }
 
 void ArmSim::set_gravity(const std::array<double, 3>& g) noexcept {
   for (int i = 0; i < 3; ++i) model_->opt.gravity[i] = g[static_cast<std::size_t>(i)];
+}
+
+Result<int> ArmSim::find_site(std::string_view name) const {
+  const int id = mj_name2id(model_.get(), mjOBJ_SITE, std::string(name).c_str());
+  if (id < 0) return make_error(Errc::kNotFound, "model '" + path_ + "' has no site '" + std::string(name) + "'");
+  return id;
+}
+
+SitePose ArmSim::site_pose(int site) noexcept {
+  // After mj_step the stored site poses are those of the state before the step: recompute them
+  // from the present joint positions (kinematics only; the next step recomputes everything anyway).
+  mj_kinematics(model_.get(), data_.get());
+  const mjData* d = data_.get();
+  SitePose pose;
+  for (std::size_t i = 0; i < 3; ++i) pose.position[i] = d->site_xpos[3 * static_cast<std::ptrdiff_t>(site) + i];
+  for (std::size_t i = 0; i < 9; ++i) pose.rotation[i] = d->site_xmat[9 * static_cast<std::ptrdiff_t>(site) + i];
+  return pose;
 }
 
 // What a sensor would report: the true state, plus noise only in what is handed out.
@@ -220,27 +370,10 @@ void ArmSim::measure() noexcept {
     q_meas_[i] = d->qpos[qpos_adr_[i]];
     qd_meas_[i] = d->qvel[dof_adr_[i]];
     if (noisy) {
-      q_meas_[i] += noise_.position_std * gaussian();
-      qd_meas_[i] += noise_.velocity_std * gaussian();
+      q_meas_[i] += noise_.position_std * gaussian_.next();
+      qd_meas_[i] += noise_.velocity_std * gaussian_.next();
     }
   }
-}
-
-// Box-Muller on splitmix64: a few lines, fully specified, so noise is identical on every
-// platform and library (std::normal_distribution is implementation-defined).
-double ArmSim::gaussian() noexcept {
-  if (has_spare_) {
-    has_spare_ = false;
-    return spare_normal_;
-  }
-  constexpr double kScale = 1.0 / 9007199254740992.0;                               // 2^-53
-  const double u1 = (static_cast<double>(splitmix64(rng_) >> 11U) + 1.0) * kScale;  // (0, 1]
-  const double u2 = static_cast<double>(splitmix64(rng_) >> 11U) * kScale;
-  const double r = std::sqrt(-2.0 * std::log(u1));
-  const double phi = 2.0 * std::numbers::pi * u2;
-  spare_normal_ = r * std::sin(phi);
-  has_spare_ = true;
-  return r * std::cos(phi);
 }
 
 }  // namespace chimera::sim

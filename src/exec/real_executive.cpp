@@ -12,6 +12,7 @@
 #include <set>
 #include <system_error>
 #include <tuple>
+#include <utility>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -130,14 +131,42 @@ RealExecutive::RealExecutive(const std::vector<Task*>& tasks, const ReleaseOrder
       dispatchers_.push_back(std::move(d));
     }
   }
+  form_threads(order);
+}
+
+void RealExecutive::form_threads(const ReleaseOrder& order) {
+  // Under rm and dm, periodic tasks of one CPU and one period share a priority, and SCHED_FIFO
+  // would run their threads one after the other: one thread runs them, in data-flow order.
+  // Everything else (aperiodic tasks, edf and muf's per-job priorities) has a thread of its own.
+  std::map<std::tuple<int, int, std::int64_t>, TaskThread*> shared;
+  std::vector<std::size_t> by_rank(workers_.size());
+  for (std::size_t i = 0; i < by_rank.size(); ++i) by_rank[i] = i;
+  std::stable_sort(by_rank.begin(), by_rank.end(),
+                   [&](std::size_t a, std::size_t b) { return order.rank[a] < order.rank[b]; });
+  for (const std::size_t i : by_rank) {
+    Worker& w = *workers_[i];
+    const bool groups = w.dispatcher == nullptr && w.task->periodic();
+    const auto key = std::tuple{w.cpu, w.fixed_priority, w.task->period_ns()};
+    TaskThread* t = groups && shared.contains(key) ? shared[key] : nullptr;
+    if (t == nullptr) {
+      threads_.push_back(std::make_unique<TaskThread>());
+      t = threads_.back().get();
+      t->cpu = w.cpu;
+      t->priority = w.fixed_priority;
+      if (groups) shared[key] = t;
+    }
+    t->members.push_back(&w);
+    w.thread = t;
+  }
 }
 
 RealExecutive::~RealExecutive() {
   for (std::size_t i = 0; i < workers_.size(); ++i) {
     Worker& w = *workers_[i];
-    if (w.running && w.task->state() != TaskState::kNotCreated) (void)signal(i, Signal::kKill);
-    if (w.running) pthread_join(w.thread, nullptr);
+    if (w.thread->running && w.task->state() != TaskState::kNotCreated) (void)signal(i, Signal::kKill);
   }
+  for (auto& t : threads_)
+    if (t->running) pthread_join(t->handle, nullptr);  // its last member's kill ended it
 }
 
 std::int64_t RealExecutive::now_ns() const { return monotonic_ns() - epoch_ns_; }
@@ -145,13 +174,15 @@ std::int64_t RealExecutive::now_ns() const { return monotonic_ns() - epoch_ns_; 
 int RealExecutive::fixed_priority(std::size_t index) const { return workers_[index]->fixed_priority; }
 
 namespace {
-void* worker_entry(void* arg) {
-  static_cast<Worker*>(arg)->main();
+void* thread_entry(void* arg) {
+  static_cast<TaskThread*>(arg)->main();
   return nullptr;
 }
 }  // namespace
 
-Result<void> RealExecutive::start_thread(Worker& w) {
+Result<void> RealExecutive::start_thread(TaskThread& w) {
+  w.exiting.store(false, std::memory_order_relaxed);  // a new thread; the old one was joined
+  w.alive = 0;                                        // written before the thread exists
   pthread_attr_t attr;
   pthread_attr_init(&attr);
   pthread_attr_setstacksize(&attr, kStackBytes);
@@ -160,16 +191,17 @@ Result<void> RealExecutive::start_thread(Worker& w) {
   CPU_SET(static_cast<unsigned>(w.cpu), &cpus);
   // Partitioned scheduling needs real-time priorities; ordinary threads do better where the
   // kernel balances them (pinned, they starve behind other load), unless the file pins them.
-  if (realtime_ || w.task->spec().cpu) pthread_attr_setaffinity_np(&attr, sizeof(cpu_set_t), &cpus);
+  const bool file_pins = w.members.front()->task->spec().cpu.has_value();
+  if (realtime_ || file_pins) pthread_attr_setaffinity_np(&attr, sizeof(cpu_set_t), &cpus);
   int rc = EPERM;
   if (realtime_) {
     sched_param sp{};
-    sp.sched_priority = w.fixed_priority;
+    sp.sched_priority = w.priority;
     pthread_attr_setinheritsched(&attr, PTHREAD_EXPLICIT_SCHED);
     pthread_attr_setschedpolicy(&attr, SCHED_FIFO);
     pthread_attr_setschedparam(&attr, &sp);
-    w.current_priority.store(w.fixed_priority, std::memory_order_relaxed);  // before the thread exists
-    rc = pthread_create(&w.thread, &attr, worker_entry, &w);
+    for (Worker* m : w.members) m->current_priority.store(w.priority, std::memory_order_relaxed);  // before it runs
+    rc = pthread_create(&w.handle, &attr, thread_entry, &w);
     if (rc == EPERM)
       warn_once(g_warned_fifo,
                 "SCHED_FIFO is not permitted here: tasks run as ordinary threads, so priorities (and the edf "
@@ -177,24 +209,31 @@ Result<void> RealExecutive::start_thread(Worker& w) {
   }
   if (rc == EPERM) {
     pthread_attr_setinheritsched(&attr, PTHREAD_INHERIT_SCHED);
-    if (!w.task->spec().cpu && sched_getaffinity(0, sizeof(cpu_set_t), &cpus) == 0)
+    if (!file_pins && sched_getaffinity(0, sizeof(cpu_set_t), &cpus) == 0)
       pthread_attr_setaffinity_np(&attr, sizeof(cpu_set_t), &cpus);  // ordinary threads: unpinned
-    rc = pthread_create(&w.thread, &attr, worker_entry, &w);
+    rc = pthread_create(&w.handle, &attr, thread_entry, &w);
   }
   pthread_attr_destroy(&attr);
   if (rc != 0)
-    return make_error(Errc::kSystem, fmt::format("{}: cannot start its thread: {}", w.task->name(),
+    return make_error(Errc::kSystem, fmt::format("{}: cannot start its thread: {}", w.members.front()->task->name(),
                                                  std::generic_category().message(rc)));
   w.running = true;
   return {};
 }
 
-Result<void> RealExecutive::post(Worker& w, Mail mail) {
+std::uint32_t RealExecutive::send(Worker& w, const Mail& mail) {
   w.mail = mail;
   const std::uint32_t seq = w.request_seq.load(std::memory_order_relaxed) + 1;  // only this thread writes it
   w.request_seq.store(seq, std::memory_order_release);                          // release: publishes `mail`
   detail::futex_wake_all(w.request_seq);
-  ring_bell(w);  // an aperiodic task may be asleep on its event source instead
+  // The thread sleeps on its bell whatever it waits for (an aperiodic task on its eventfd).
+  w.thread->bell.fetch_add(1, std::memory_order_release);  // release: the mail is seen after the wake
+  detail::futex_wake_all(w.thread->bell);
+  ring_bell(w);
+  return seq;
+}
+
+Result<void> RealExecutive::await(Worker& w, std::uint32_t seq) {
   const std::int64_t give_up = monotonic_ns() + kReplyTimeoutNs;
   for (;;) {
     const std::uint32_t done = w.done_seq.load(std::memory_order_acquire);  // acquire: see `reply`
@@ -205,19 +244,31 @@ Result<void> RealExecutive::post(Worker& w, Mail mail) {
   }
   Result<void> r = std::move(w.reply);
   w.reply = Result<void>{};
-  if (w.task->state() == TaskState::kNotCreated) {
-    pthread_join(w.thread, nullptr);  // its thread has returned after the kill (or a failed init)
-    w.running = false;
+  if (w.thread->exiting.load(std::memory_order_acquire)) {  // acquire: set before the answer
+    pthread_join(w.thread->handle, nullptr);                // its last member was killed (or failed its init)
+    w.thread->running = false;
   }
   return r;
+}
+
+Result<void> RealExecutive::post(Worker& w, Mail mail) { return await(w, send(w, mail)); }
+
+Result<void> RealExecutive::post_all(const std::vector<std::size_t>& indices, const std::vector<Mail>& mails) {
+  std::vector<std::uint32_t> seqs;
+  seqs.reserve(indices.size());
+  for (std::size_t n = 0; n < indices.size(); ++n) seqs.push_back(send(*workers_[indices[n]], mails[n]));
+  Result<void> first;
+  for (std::size_t n = 0; n < indices.size(); ++n)
+    if (auto r = await(*workers_[indices[n]], seqs[n]); !r && first) first = r;
+  return first;
 }
 
 Result<void> RealExecutive::signal(std::size_t index, Signal sig) {
   std::lock_guard<std::mutex> lock(control_mutex_);
   Worker& w = *workers_[index];
-  if (!w.running) {
+  if (!w.thread->running) {
     if (sig != Signal::kSpawn) return w.task->apply(sig, now_ns());  // refused by the state table
-    if (auto started = start_thread(w); !started) return started;
+    if (auto started = start_thread(*w.thread); !started) return started;
   }
   return post(w, Mail{MailKind::kSignal, sig, 0});
 }
@@ -233,9 +284,28 @@ Result<void> RealExecutive::commit_switch(const std::vector<std::size_t>& leavin
   // Every leaving task answers once it is off: after its last release before the commit. Only
   // then may a joining task turn on, since on() publishes outputs a leaving task wrote: one
   // writer per variable at any time.
-  for (const std::size_t i : leaving)
-    if (auto r = post(*workers_[i], Mail{MailKind::kLeaveAt, Signal::kOff, epoch_ns_ + commit_ns}); !r) return r;
-  return turn_on_locked(joining, commit_ns);
+  // Successors of the joining tasks must wait for them from the commit's release on, even if the
+  // commit runs late: tell them before anything changes.
+  for (const std::size_t i : joining) {
+    Worker& w = *workers_[i];
+    if (w.task->periodic())
+      w.joining_k.store((commit_ns + w.task->period_ns() - 1) / w.task->period_ns(), std::memory_order_release);
+  }
+  const std::vector<Mail> leave(leaving.size(), Mail{MailKind::kLeaveAt, Signal::kOff, epoch_ns_ + commit_ns});
+  Result<void> r = post_all(leaving, leave);
+  // Each joining task turns on right before its first release from the commit on, on its own
+  // thread: not earlier, since on() publishes outputs a consumer may still be reading the leaving
+  // producer's last value of. They are all posted at once and answer as each turns on.
+  std::vector<Mail> join;
+  for (const std::size_t i : joining) {
+    const Worker& w = *workers_[i];
+    const std::int64_t p = w.task->periodic() ? w.task->period_ns() : 1;
+    join.push_back(Mail{MailKind::kOnAt, Signal::kOn, (std::max(commit_ns, now_ns()) + p - 1) / p});
+  }
+  if (auto on = post_all(joining, join); r && !on) r = on;
+  for (const std::size_t i : joining)
+    workers_[i]->joining_k.store(-1, std::memory_order_release);  // scheduled says it now
+  return r;
 }
 
 void RealExecutive::set_plan(const SchedulePlan& plan) {

@@ -20,6 +20,7 @@
 namespace chimera {
 
 struct Worker;
+struct TaskThread;
 struct Mail;
 class PriorityDispatcher;
 
@@ -62,13 +63,20 @@ class RealExecutive {
   [[nodiscard]] int fixed_priority(std::size_t index) const;
 
  private:
-  Result<void> start_thread(Worker& w);
+  Result<void> start_thread(TaskThread& thread);
+  void form_threads(const ReleaseOrder& order);
   /// Posts `mail` to a task's thread and waits for its answer. Not real-time safe.
   Result<void> post(Worker& w, Mail mail);
+  /// Posts `mail` to several tasks' threads at once, then waits for every answer.
+  Result<void> post_all(const std::vector<std::size_t>& indices, const std::vector<Mail>& mails);
+  /// Posts only; returns the sequence number of the answer to wait for.
+  std::uint32_t send(Worker& w, const Mail& mail);
+  Result<void> await(Worker& w, std::uint32_t seq);
   Result<void> turn_on_locked(const std::vector<std::size_t>& indices, std::int64_t not_before_ns);
 
   std::vector<std::unique_ptr<PriorityDispatcher>> dispatchers_;  // outlive the workers that poke them
   std::vector<std::unique_ptr<Worker>> workers_;
+  std::vector<std::unique_ptr<TaskThread>> threads_;
   const GlobalTable& table_;
   std::int64_t epoch_ns_ = 0;
   bool realtime_ = false;

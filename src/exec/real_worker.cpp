@@ -39,39 +39,11 @@ void ring_bell(const Worker& w) noexcept {
   (void)!::write(w.bell_fd, &one, sizeof(one));  // an eventfd counter: a full one still wakes
 }
 
-void Worker::main() {
-  self.store(pthread_self(), std::memory_order_relaxed);  // published by job_active's release store
-  // Touch the stack once so that its pages are resident before the first cycle.
-  std::array<char, std::size_t{64} * 1024> prefault;  // NOLINT(cppcoreguidelines-pro-type-member-init): written next
-  std::memset(prefault.data(), 0, prefault.size());
-  asm volatile("" : : "r"(prefault.data()) : "memory");  // keeps the compiler from dropping the writes
-
-  std::uint32_t seen = 0;
-  std::int64_t k = 0;
-  for (;;) {
-    const std::uint32_t req = request_seq.load(std::memory_order_acquire);  // acquire: see `mail`
-    if (req != seen) {
-      seen = req;
-      if (!handle(req, k)) return;
-      continue;
-    }
-    if (task->state() != TaskState::kOn) {
-      scheduled.store(-1, std::memory_order_release);  // release: successors stop waiting on us
-      if (bell_fd >= 0) {
-        pollfd p{bell_fd, POLLIN, 0};
-        (void)::poll(&p, 1, -1);
-        std::uint64_t drained = 0;
-        (void)!::read(bell_fd, &drained, sizeof(drained));
-      } else {
-        detail::futex_wait(request_seq, req, -1);
-      }
-      continue;
-    }
-    if (task->periodic())
-      run_periodic(req, k);
-    else
-      run_aperiodic(req);
-  }
+bool Worker::take_mail() {
+  const std::uint32_t req = request_seq.load(std::memory_order_acquire);  // acquire: see `mail`
+  if (req == seen) return true;
+  seen = req;
+  return handle(req);
 }
 
 void Worker::reply_to(std::uint32_t seq) {
@@ -79,7 +51,7 @@ void Worker::reply_to(std::uint32_t seq) {
   detail::futex_wake_all(done_seq);
 }
 
-bool Worker::handle(std::uint32_t seq, std::int64_t& k) {
+bool Worker::handle(std::uint32_t seq) {
   const std::int64_t now = exec->now_ns();
   const TaskState before = task->state();
   switch (mail.kind) {
@@ -97,17 +69,26 @@ bool Worker::handle(std::uint32_t seq, std::int64_t& k) {
       // release before the switch, leaves at once; otherwise after its current job (the loop).
       if (!task->periodic() || task->state() != TaskState::kOn || exec->epoch_ns() + k * task->period_ns() >= leave_at)
         leave();
-      return task->state() != TaskState::kNotCreated;
+      return true;
     case MailKind::kReinit:
       reply = task->reinit(now)
                   ? Result<void>{}
                   : make_error(Errc::kModuleFault, task->name() + ": reinit failed; the task is no longer ON");
       reply_to(seq);
       return task->state() != TaskState::kNotCreated;
+    case MailKind::kOnAt:
+      // Turned on at its first release, not now: on() publishes its outputs, and a consumer may
+      // still be reading the leaving producer's last value of the release before.
+      if (task->periodic() && task->state() == TaskState::kOff) {
+        on_at = mail.at;
+        on_seq = seq;
+        return true;
+      }
+      break;
     case MailKind::kSignal:
     case MailKind::kOnHeld: break;
   }
-  const Signal request = mail.kind == MailKind::kOnHeld ? Signal::kOn : mail.signal;
+  const Signal request = mail.kind == MailKind::kSignal ? mail.signal : Signal::kOn;
   // A task turning on joins the grid at the next whole multiple of its period. Successors must
   // see that release as scheduled as soon as they can see the task ON, or one of them could run
   // its shared release without waiting for it: publish it before the state changes. (A held
@@ -124,8 +105,26 @@ bool Worker::handle(std::uint32_t seq, std::int64_t& k) {
     on_turned_on();
   }
   const bool alive = task->state() != TaskState::kNotCreated;
+  // The thread's count of living tasks; with none left it ends, and says so before answering,
+  // so that the control thread knows to join it.
+  if (before == TaskState::kNotCreated && alive) ++thread->alive;
+  if (before != TaskState::kNotCreated && !alive) --thread->alive;
+  if (!alive && thread->alive == 0) thread->exiting.store(true, std::memory_order_release);  // before the answer
   reply_to(seq);
   return alive;
+}
+
+void Worker::join_now() {
+  const std::uint32_t seq = on_seq;
+  scheduled.store(on_at, std::memory_order_release);  // release: successors wait for this release
+  reply = task->apply(Signal::kOn, exec->now_ns());
+  if (task->state() == TaskState::kOn) {
+    k = on_at;
+    on_turned_on();
+  }
+  on_at = -1;
+  on_seq = 0;
+  reply_to(seq);
 }
 
 void Worker::leave() {
@@ -176,11 +175,25 @@ std::int64_t Worker::run_job(std::int64_t release_abs) {
   return used;
 }
 
-void Worker::run_periodic(std::uint32_t req, std::int64_t& k) {
-  if (held) {  // waiting for kJoin; `scheduled` is the control thread's until then
-    detail::futex_wait(request_seq, req, -1);
-    return;
+std::int64_t Worker::prepare() {
+  if (on_at >= 0) return exec->epoch_ns() + on_at * task->period_ns();  // a switch: on at that release
+  if (task->state() != TaskState::kOn) {
+    scheduled.store(-1, std::memory_order_release);  // release: successors stop waiting on us
+    return kNever;
   }
+  if (held) return kNever;  // waiting for kJoin; `scheduled` is the control thread's until then
+  const std::int64_t release_abs = exec->epoch_ns() + k * task->period_ns();
+  if (leave_seq != 0 && release_abs >= leave_at) return 0;  // a switch: leave now
+  scheduled.store(k, std::memory_order_release);            // release: pairs with successors' acquire load
+  return release_abs;
+}
+
+void Worker::act() {
+  if (on_at >= 0) {
+    join_now();
+    return;  // the loop prepares its first release, which has come
+  }
+  if (task->state() != TaskState::kOn || held) return;
   const std::int64_t period = task->period_ns();
   const std::int64_t epoch = exec->epoch_ns();
   std::int64_t release_abs = epoch + k * period;
@@ -188,12 +201,7 @@ void Worker::run_periodic(std::uint32_t req, std::int64_t& k) {
     leave();  // a switch: this task's last release came before the commit
     return;
   }
-  scheduled.store(k, std::memory_order_release);  // release: pairs with successors' acquire load
   const std::int64_t now = monotonic_ns();
-  if (now < release_abs) {
-    detail::futex_wait(request_seq, req, release_abs);
-    return;  // a signal, a spurious wake, or the release: the loop tells which
-  }
   if (task->spec().late == LatePolicy::kSkip) {
     // Releases whose deadline has already passed are not worth starting: skip them.
     std::uint64_t skipped = 0;
@@ -204,7 +212,7 @@ void Worker::run_periodic(std::uint32_t req, std::int64_t& k) {
     }
     if (skipped != 0) {
       task->skip_releases(skipped, now - epoch);
-      scheduled.store(k, std::memory_order_release);  // release: as above
+      scheduled.store(k, std::memory_order_release);  // release: as in prepare()
       if (task->state() != TaskState::kOn || now < release_abs) return;
     }
   }
@@ -226,7 +234,8 @@ void Worker::refill(std::int64_t now_abs) noexcept {
   }
 }
 
-void Worker::run_aperiodic(std::uint32_t req) {
+void Worker::run_aperiodic() {
+  const std::uint32_t req = seen;
   const std::optional<ServerSpec>& server = task->spec().server;
   const std::int64_t now = monotonic_ns();
   refill(now);
@@ -272,21 +281,25 @@ void Worker::run_aperiodic(std::uint32_t req) {
   }
 }
 
-void Worker::wait_for_predecessors(std::int64_t k, std::int64_t release_abs) const {
+void Worker::wait_for_predecessors(std::int64_t release, std::int64_t release_abs) const {
   // Bounded: a predecessor that keeps us waiting more than half our deadline no longer holds us
   // back. Counted from when the wait starts, so that the order still holds while tasks catch up
   // after a stall (when every release is already in the past).
   const std::int64_t give_up = std::max(release_abs, monotonic_ns()) + task->spec().deadline_ns / 2;
   for (Worker* p : predecessors) {
     for (;;) {
-      if (reached(p->completed.load(std::memory_order_acquire), k)) break;  // acquire: its cycle is done
-      if (p->task->state() != TaskState::kOn) break;
-      const std::int64_t s = p->scheduled.load(std::memory_order_acquire);  // acquire: pairs with its store
-      if (s < 0 || s > k) break;                           // not released, or joined after this instant
-      p->waiters.fetch_add(1, std::memory_order_seq_cst);  // seq_cst: Dekker with the producer (see run_periodic)
+      if (reached(p->completed.load(std::memory_order_acquire), release)) break;  // acquire: its cycle is done
+      const std::int64_t joins = p->joining_k.load(std::memory_order_acquire);    // acquire: pairs with the commit
+      const bool joining = joins >= 0 && joins <= release;
+      if (!joining) {
+        if (p->task->state() != TaskState::kOn) break;
+        const std::int64_t s = p->scheduled.load(std::memory_order_acquire);  // acquire: pairs with its store
+        if (s < 0 || s > release) break;  // not released, or joined after this instant
+      }
+      p->waiters.fetch_add(1, std::memory_order_seq_cst);  // seq_cst: Dekker with the producer (see act)
       const std::uint32_t c = p->completed.load(std::memory_order_seq_cst);
       bool in_time = true;
-      if (!reached(c, k)) in_time = detail::futex_wait(p->completed, c, give_up);
+      if (!reached(c, release)) in_time = detail::futex_wait(p->completed, c, give_up);
       p->waiters.fetch_sub(1, std::memory_order_relaxed);  // only a hint for the producer's wake
       if (!in_time && monotonic_ns() >= give_up) {
         task->record_order_timeout();

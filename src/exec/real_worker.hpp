@@ -1,7 +1,11 @@
 #pragma once
-// One task's thread on the real clock: its mailbox for signals, its releases (periodic timer or
-// aperiodic trigger), the same-rate precedence wait, its sporadic server and, under EDF or MUF,
-// the job it publishes for its CPU's priority dispatcher. Private to the real executive.
+// The real clock's threads and the tasks they run. A Worker is one task's side: its mailbox for
+// signals, its releases (periodic grid or aperiodic trigger), the same-rate precedence wait, its
+// sporadic server and, under EDF or MUF, the job it publishes for its CPU's priority dispatcher.
+// A TaskThread runs one task, or under rm and dm the periodic tasks that share a CPU, a period
+// and so a priority: SCHED_FIFO would run such threads one after the other, never preempting
+// each other, so one thread running them in data-flow order behaves the same with one wake-up
+// instead of many. Private to the real executive.
 
 #include <pthread.h>
 #include <sched.h>
@@ -9,6 +13,7 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "chimera/exec/task.hpp"
@@ -18,6 +23,26 @@ namespace chimera {
 
 class RealExecutive;
 class PriorityDispatcher;
+struct Worker;
+
+/// One thread and the tasks it runs (in data-flow order).
+struct TaskThread {
+  std::vector<Worker*> members;
+  int cpu = 0;
+  int priority = 1;
+  pthread_t handle{};    // the control thread's: for join
+  bool running = false;  // the control thread's view: the thread exists
+  // Rung by every mail to a member: the thread sleeps on this one word whatever it waits for.
+  alignas(64) std::atomic<std::uint32_t> bell{0};
+  int alive = 0;                     // members spawned and not killed; the thread's own count
+  std::atomic<bool> exiting{false};  // set before the answer to the mail that killed its last member
+
+  /// The body: until no member is alive.
+  void main();
+
+ private:
+  void run_periodic_members();
+};
 
 /// What the control thread asks of a task's thread.
 enum class MailKind : std::uint8_t {
@@ -26,6 +51,7 @@ enum class MailKind : std::uint8_t {
   kJoin,     // first release at index `at`, set by the control thread for every task of a group
   kLeaveAt,  // turn off before the first release at or after absolute time `at`; reply once off
   kReinit,   // an in-const changed: reinit() between two cycles
+  kOnAt,     // a switch: turn on right before release index `at` and run it; reply once on
 };
 
 struct Mail {
@@ -46,8 +72,7 @@ struct Worker {
   int fixed_priority = 1;                    // SCHED_FIFO priority under rm / dm (and at start)
   PriorityDispatcher* dispatcher = nullptr;  // edf / muf: who ranks its jobs
   int bell_fd = -1;                          // aperiodic: eventfd rung by signals and producers
-  pthread_t thread{};                        // the control thread's handle (join)
-  bool running = false;                      // the control thread's view: a thread exists
+  TaskThread* thread = nullptr;              // the thread that runs it
 
   // Mailbox: written by the control thread, read by the task's thread.
   alignas(64) std::atomic<std::uint32_t> request_seq{0};
@@ -60,6 +85,10 @@ struct Worker {
   alignas(64) std::atomic<std::uint32_t> completed{0};
   std::atomic<std::uint32_t> waiters{0};
   std::atomic<std::int64_t> scheduled{-1};  // release index about to run; -1 when not released
+  // A switch's commit: the release this (still OFF) task will join at; -1 when none. Successors
+  // wait for it at that release as if it were ON, so that a commit running late cannot make them
+  // read the leaving producer's last value.
+  std::atomic<std::int64_t> joining_k{-1};
 
   // The job it publishes for its dispatcher (edf / muf), and its own thread handle for it.
   alignas(64) std::atomic<bool> job_active{false};
@@ -72,10 +101,15 @@ struct Worker {
   alignas(64) std::atomic<int> trigger_var{-1};
   std::atomic<bool> update_pending{false};
 
-  // Group starts and switches: touched only by the task's own thread.
+  // Touched only by the task's thread.
+  std::uint32_t seen = 0;  // the last mail handled
+  std::int64_t k = 0;      // periodic: index of its next release on the grid
+  // Group starts and switches: touched only by the task's thread.
   bool held = false;            // ON, but waiting for kJoin before its first release
   std::int64_t leave_at = -1;   // absolute time: turn off before the first release at or after it
   std::uint32_t leave_seq = 0;  // the kLeaveAt request to answer once off (0: none)
+  std::int64_t on_at = -1;      // kOnAt: the release index to turn on right before (-1: none)
+  std::uint32_t on_seq = 0;     // the kOnAt request to answer once on
 
   // Sporadic server: touched only by the task's own thread.
   static constexpr std::size_t kMaxRefills = 64;
@@ -89,17 +123,28 @@ struct Worker {
   Worker& operator=(const Worker&) = delete;
   ~Worker();
 
-  /// The thread's body: from spawn until the task is killed (or its init fails).
-  void main();
+  /// Handles the mail if there is new mail. Returns false when the task has just been destroyed
+  /// (killed, or its init failed). On the task's thread.
+  bool take_mail();
+  /// Periodic: the absolute time at which it has something to do (its next release, a pending
+  /// join or leave), or kNever when nothing until mail; publishes `scheduled` for successors.
+  [[nodiscard]] std::int64_t prepare();
+  /// Periodic, once prepare()'s time has come: the release (late releases skipped under
+  /// late: skip), or the pending join or leave. On the task's thread.
+  void act();
+  /// Aperiodic: waits for its trigger (or mail) and serves one event within its server's budget.
+  void run_aperiodic();
+
+  static constexpr std::int64_t kNever = std::numeric_limits<std::int64_t>::max();
 
  private:
-  bool handle(std::uint32_t seq, std::int64_t& k);
+  bool handle(std::uint32_t seq);
   void reply_to(std::uint32_t seq);
   /// Turns off now for a pending kLeaveAt, and answers it.
   void leave();
-  void run_periodic(std::uint32_t seq, std::int64_t& k);
-  void run_aperiodic(std::uint32_t seq);
-  void wait_for_predecessors(std::int64_t k, std::int64_t release_abs) const;
+  /// A pending kOnAt whose release has come: turns on and answers.
+  void join_now();
+  void wait_for_predecessors(std::int64_t release, std::int64_t release_abs) const;
   /// Runs one job and tells successors and subscribers; returns the execution time it used.
   std::int64_t run_job(std::int64_t release_abs);
   void publish_job(std::int64_t release_abs);

@@ -18,13 +18,9 @@ struct SchedulePlan {
   std::vector<TaskUrgency> urgency;  // per task of the file
 };
 
-/// The execution time analysis and assignment count for a task: its wcet, else its virtual_exec,
-/// else 0 (unknown).
-std::int64_t planned_cost_ns(const TaskSpec& task);
-
-/// Plans every task of the file on `cpus` (the CPUs the subsystem may use), with the critical
-/// set of MUF computed for the tasks of `configuration` (the others are planned as if alone).
-/// Not real-time safe.
+/// Plans every task of the file on `cpus` (the CPUs the subsystem may use) as `chimera analyze`
+/// does (analysis/cpu_assignment.hpp), with MUF's critical set computed for the tasks of
+/// `configuration` (the others are planned as if alone). Not real-time safe.
 SchedulePlan make_schedule_plan(const ResolvedSubsystem& subsystem, const ReleaseOrder& order,
                                 const std::vector<int>& cpus, const std::vector<std::string>& configuration);
 

@@ -203,6 +203,13 @@ Result<void> Task::spawn(std::int64_t now_ns) {
   auto local = LocalTable::create(table_, resolved_.bindings);
   if (!local) return make_error(Errc::kModuleFault, fmt::format("{}: {}", spec_.name, local.error().message));
   local_ = std::make_unique<LocalTable>(std::move(*local));
+  // Out-consts start as the values the module declared (what verification already used); a
+  // module may still write them in init.
+  for (const auto& port : resolved_.decls.ports()) {
+    if (port.kind != PortKind::kOutConst) continue;
+    if (auto out = local_->output<double>(port.name))
+      for (std::size_t i = 0; i < out->size() && i < port.value.size(); ++i) (*out)[i] = port.value[i];
+  }
   module_ = resolved_.module->make();
   timing_ = CycleTiming{now_ns, now_ns, spec_.period_ns.value_or(0), 0, virtual_clock_, Fault::kNone};
   trigger_ = Trigger{};
@@ -229,8 +236,13 @@ Result<void> Task::spawn(std::int64_t now_ns) {
     events_.push(now_ns, "init failed; task not created: ", reason.c_str());
     return make_error(Errc::kModuleFault, fmt::format("{}: init failed: {}", spec_.name, reason));
   }
-  local_->push_out_consts();
-  local_->push_out_vars();
+  // Publishing what init produced lets consumers start from real values; not while another
+  // producer of these variables is ON (a task created in the background for a switch): one
+  // writer per variable at any time. Its on() publishes them when it joins.
+  if (publish_at_spawn_) {
+    local_->push_out_consts();
+    local_->push_out_vars();
+  }
   if (!periodic() && !trigger_.any())
     events_.push(now_ns, "aperiodic, and its module declared no trigger in init: it will never cycle", nullptr);
   set_state(TaskState::kOff);

@@ -105,13 +105,25 @@ Result<SwitchRecord> Subsystem::switch_locked(std::string_view name, std::string
   record.spawned = names_of(m.tasks, plan->to_spawn);
   record.flag_raised = !plan->to_spawn.empty();
 
+  // The in-consts that may change value: the out-consts of the tasks leaving and joining.
+  std::vector<std::string> consts;
+  for (const std::size_t i : plan->leaving)
+    for (auto& c : m.tasks[i]->const_outputs()) consts.push_back(std::move(c));
+  for (const std::size_t i : plan->joining)
+    for (auto& c : m.tasks[i]->const_outputs()) consts.push_back(std::move(c));
+  // Read before any task is created: a new producer publishes its out-consts at init.
+  const auto before = read_values(*m.table, consts);
+
   // A switch that must create tasks takes longer than a cycle: the flag tells every module so,
   // and critical ones (the robot interfaces) hold still until it is lowered.
   m.switching_flag = record.flag_raised;
   m.update_flag();
   std::vector<std::size_t> created;
   for (const std::size_t i : plan->to_spawn) {
-    if (auto r = m.signal(i, Signal::kSpawn); !r) {
+    m.tasks[i]->set_publish_at_spawn(false);  // the current configuration's producers are still ON
+    auto r = m.signal(i, Signal::kSpawn);
+    m.tasks[i]->set_publish_at_spawn(true);
+    if (!r) {
       for (auto it = created.rbegin(); it != created.rend(); ++it) (void)m.signal(*it, Signal::kKill);
       m.switching_flag = false;
       m.update_flag();
@@ -121,14 +133,6 @@ Result<SwitchRecord> Subsystem::switch_locked(std::string_view name, std::string
     }
     created.push_back(i);
   }
-
-  // The in-consts that may change value: the out-consts of the tasks leaving and joining.
-  std::vector<std::string> consts;
-  for (const std::size_t i : plan->leaving)
-    for (auto& c : m.tasks[i]->const_outputs()) consts.push_back(std::move(c));
-  for (const std::size_t i : plan->joining)
-    for (auto& c : m.tasks[i]->const_outputs()) consts.push_back(std::move(c));
-  const auto before = read_values(*m.table, consts);
 
   // Phase 2, commit at one cycle boundary.
   std::int64_t shortest = 0;

@@ -1,6 +1,9 @@
 // The real-time path allocates nothing. While an AllocationGuard is armed every allocation is
 // counted and operator new fails by throwing. Cycles of the framework (transfers, statistics,
-// timing, dispatch) and of the Figure 4 modules, data logger included, run armed, on both clocks.
+// timing, dispatch) and of the library's modules run armed: Figure 4 on both clocks, its data
+// logger included, Figures 8 and 9 (the kinematics, the damped least squares, the integrator, the
+// camera, the position-mode robot), Figure 3's join, Figure 6's teleoperation, and both robot
+// interfaces' hold while the illegal-configuration flag is raised.
 
 #include <unistd.h>
 
@@ -184,6 +187,82 @@ tasks:
   ASSERT_NE(s, nullptr);
   EXPECT_EQ(allocations_while_running(*s, 500 * kMs), 0) << "allocations during 500 cycles of each task";
   EXPECT_EQ(total_cycles(*s), 3u * 510u);
+}
+
+std::unique_ptr<Subsystem> example(const char* file, const char* config) {
+  auto spec = load_subsystem_file(std::string(CHIMERA_EXAMPLES_DIR "/") + file, Registry::global());
+  EXPECT_TRUE(spec.ok()) << (spec.ok() ? "" : spec.error().message);
+  if (!spec.ok()) return nullptr;
+  RunOptions o;
+  o.clock = ClockKind::kVirtual;
+  o.configuration = config;
+  o.shm_suffix = testing::unique_suffix();
+  auto s = Subsystem::create(*spec, Registry::global(), o);
+  EXPECT_TRUE(s.ok()) << (s.ok() ? "" : s.error().message);
+  if (!s.ok()) return nullptr;
+  EXPECT_TRUE((*s)->start().ok());
+  return std::move(*s);
+}
+
+// Runs `s` armed for `ns` after a warm-up; every task ON must stay ON.
+void expect_no_allocation(Subsystem& s, std::int64_t ns) {
+  s.run_for(100 * kMs);
+  long allocations = 0;
+  {
+    AllocationGuard guard(AllocationGuard::OnNew::kFail);
+    s.run_for(ns);
+    allocations = AllocationGuard::count();
+  }
+  EXPECT_EQ(allocations, 0) << "allocations inside cycles";
+  for (const auto& t : s.snapshot()) {
+    if (t.state != TaskState::kNotCreated) {
+      EXPECT_EQ(t.state, TaskState::kOn) << t.name << ": " << t.last_error;
+    }
+  }
+}
+
+TEST(NoAllocationInCycle, Figure8InverseKinematicsOnThePositionModeRobot) {
+  auto s = example("visual_servo.yaml", "standard");
+  ASSERT_NE(s, nullptr);
+  expect_no_allocation(*s, 6000 * kMs);  // through the pass near the singular posture at 5 s
+}
+
+TEST(NoAllocationInCycle, Figure9DampedLeastSquaresAndTheIntegrator) {
+  auto s = example("visual_servo.yaml", "near_singularity");
+  ASSERT_NE(s, nullptr);
+  expect_no_allocation(*s, 6000 * kMs);
+}
+
+TEST(NoAllocationInCycle, Figure6TeleoperationFromARecordedSession) {
+  auto s = example("fig6_teleop.yaml", "replay");
+  ASSERT_NE(s, nullptr);
+  expect_no_allocation(*s, 8000 * kMs);  // every command of the session, on to home
+}
+
+TEST(NoAllocationInCycle, Figure6TeleoperationByResolvedRate) {
+  auto s = example("fig6_teleop.yaml", "rate");
+  ASSERT_NE(s, nullptr);
+  expect_no_allocation(*s, 8000 * kMs);
+}
+
+TEST(NoAllocationInCycle, Figure3JoinOfTwoCameras) {
+  auto s = example("fig3_join.yaml", "joined");
+  ASSERT_NE(s, nullptr);
+  expect_no_allocation(*s, 2000 * kMs);
+}
+
+TEST(NoAllocationInCycle, BothRobotInterfacesHoldingForAnIllegalConfiguration) {
+  auto s = example("visual_servo.yaml", "standard");
+  ASSERT_NE(s, nullptr);
+  s->table().set_illegal_configuration(true);  // robot_position holds
+  expect_no_allocation(*s, 500 * kMs);
+  s->table().set_illegal_configuration(false);
+  expect_no_allocation(*s, 500 * kMs);  // and lets go
+  auto f4 = fig4(ClockKind::kVirtual);
+  f4->table().set_illegal_configuration(true);  // robot_torque holds
+  expect_no_allocation(*f4, 500 * kMs);
+  f4->table().set_illegal_configuration(false);
+  expect_no_allocation(*f4, 500 * kMs);
 }
 
 // The detector detects: a module that allocates in cycle() is caught, and its task goes to ERROR.

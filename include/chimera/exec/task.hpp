@@ -91,6 +91,9 @@ class Task {
   void set_exec_clock(ExecClock clock) noexcept { exec_clock_ = clock; }
   /// Marks the subsystem's clock as virtual in the timing modules see (set before spawn).
   void set_virtual_clock(bool is_virtual) noexcept { virtual_clock_ = is_virtual; }
+  /// Whether spawn publishes what init produced (false for a task created in the background of a
+  /// running configuration, which may hold other producers of its outputs). Set before spawn.
+  void set_publish_at_spawn(bool publish) noexcept { publish_at_spawn_ = publish; }
   /// Where its module's switch requests go, and its index there (set before spawn).
   void set_request_board(RequestBoard* board, int index) noexcept { services_ = {board, index}; }
 
@@ -137,6 +140,7 @@ class Task {
   TaskServices services_;
   ExecClock exec_clock_ = ExecClock::kWall;
   bool virtual_clock_ = false;
+  bool publish_at_spawn_ = true;
   struct Job {
     bool open = false;
     bool failed = false;          // the error path already ran (and published)

@@ -14,6 +14,7 @@
 #include "chimera/module/registry.hpp"
 #include "joint_traj_gen/quintic_via.hpp"
 #include "pid_joint/pid_law.hpp"
+#include "support/port_contract.hpp"
 
 namespace chimera {
 namespace {
@@ -23,31 +24,7 @@ constexpr std::int64_t kS = 1'000'000'000;
 
 // ---- ports: the names, kinds and sizes the contract gives --------------------------------------
 
-struct Expected {
-  std::string name;
-  PortKind kind;
-  std::string dim;
-};
-
-void expect_ports(const char* module, const std::vector<Expected>& expected) {
-  const ModuleInfo* info = Registry::global().find(module);
-  ASSERT_NE(info, nullptr) << module << " is not registered";
-  EXPECT_FALSE(info->summary.empty());
-  EXPECT_GT(info->doc.size(), 300U) << module << ": kDoc should be a real paragraph";
-  const Declarations d = info->declarations(Params{});
-  ASSERT_EQ(d.ports().size(), expected.size()) << module;
-  for (const auto& e : expected) {
-    bool found = false;
-    for (const auto& p : d.ports()) {
-      if (p.name != e.name) continue;
-      found = true;
-      EXPECT_EQ(p.kind, e.kind) << module << "." << e.name;
-      EXPECT_EQ(p.type, ElemType::kF64) << module << "." << e.name;
-      EXPECT_EQ(to_string(p.dim), e.dim) << module << "." << e.name;
-    }
-    EXPECT_TRUE(found) << module << " lacks port " << e.name;
-  }
-}
+using test::expect_ports;
 
 TEST(Fig4Modules, PortsFollowTheContract) {
   expect_ports("joint_traj_gen", {{"ndof", PortKind::kInConst, "1"},

@@ -25,9 +25,9 @@
 namespace chimera {
 namespace {
 
-using modules::cartesian::pose_of;
+using kinematics::pose_from;
+using kinematics::rotation_from_vector;
 using modules::cartesian::rotation_error;
-using modules::cartesian::rotation_of;
 using modules::cartesian::Vec3;
 
 constexpr std::int64_t kMs = 1'000'000;
@@ -94,7 +94,7 @@ class Fig6Test : public ::testing::Test {
 
   // The angle between two poses' orientations, rad.
   static double turn_between(const std::vector<double>& a, const std::vector<double>& b) {
-    return rotation_error(pose_of(a).rotation, pose_of(b).rotation).norm();
+    return rotation_error(pose_from(a).rotation, pose_from(b).rotation).norm();
   }
 
   // The recorded session of the example, checked step by step on the measured pose.
@@ -121,8 +121,8 @@ class Fig6Test : public ::testing::Test {
     run_until(*s, 4900);
     const auto turned = get(*s, "x_m");
     expect_at(turned, home, Vec3(0.05, 0.05, -0.05), tolerance, "a turn does not move the tool point");
-    const Eigen::Matrix3d expected = rotation_of(Vec3(0, 0, 0.3)) * pose_of(home).rotation;
-    EXPECT_LT(rotation_error(expected, pose_of(turned).rotation).norm(), 20 * tolerance)
+    const Eigen::Matrix3d expected = rotation_from_vector(Vec3(0, 0, 0.3)) * pose_from(home).rotation;
+    EXPECT_LT(rotation_error(expected, pose_from(turned).rotation).norm(), 20 * tolerance)
         << "turned 0.3 rad about the vertical (" << turn_between(turned, home) << " rad from the start)";
     // vel 0 -0.04 0 from 5 s, for the 0.5 s of the dead man's switch (51 cycles of 10 ms): 2.04 cm.
     run_until(*s, 6900);

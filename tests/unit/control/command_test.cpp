@@ -69,7 +69,7 @@ TEST(ParseCommand, WaitCarriesItsDuration) {
 }
 
 TEST(ParseCommand, UnknownVerbSaysTryHelp) {
-  EXPECT_EQ(refusal("switch near_singularity"), "unknown command 'switch' (try help)");
+  EXPECT_EQ(refusal("swap near_singularity"), "unknown command 'swap' (try help)");
   EXPECT_EQ(refusal("STATUS"), "unknown command 'STATUS' (try help)");
 }
 
@@ -115,12 +115,13 @@ TEST(ParseCommand, BlankAndCommentLines) {
   EXPECT_FALSE(is_blank_or_comment("status # trailing"));
 }
 
-TEST(ParseCommand, HelpCoversEveryVerbButSwitch) {
+TEST(ParseCommand, HelpCoversEveryVerb) {
   std::vector<std::string_view> verbs;
   for (const auto& h : verb_help()) verbs.push_back(verb_name(h.verb));
-  EXPECT_EQ(verbs.size(), 12U);
+  EXPECT_EQ(verbs.size(), 13U);
   for (const auto& h : verb_help()) EXPECT_FALSE(h.does.empty());
-  EXPECT_EQ(std::find(verbs.begin(), verbs.end(), "switch"), verbs.end());
+  EXPECT_NE(std::find(verbs.begin(), verbs.end(), "switch"), verbs.end());
+  EXPECT_EQ(parsed("switch near_singularity").args, (std::vector<std::string>{"near_singularity"}));
 }
 
 }  // namespace

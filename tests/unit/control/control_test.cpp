@@ -259,12 +259,16 @@ TEST_F(ControlTest, StatsOfOneTaskIsItsProfile) {
 
 TEST_F(ControlTest, HelpUnknownAndBlankLines) {
   const Reply help = run("help");
-  for (const char* verb : {"status", "spawn", "on", "off", "kill", "clear", "get", "set", "wait", "stats", "quit"})
+  for (const char* verb :
+       {"status", "spawn", "on", "off", "kill", "clear", "switch", "get", "set", "wait", "stats", "quit"})
     EXPECT_NE(help.text.find(verb), std::string::npos) << verb;
 
-  const Reply unknown = run("switch other");
+  const Reply unknown = run("swap other");
   EXPECT_FALSE(unknown.ok);
-  EXPECT_EQ(unknown.text, "unknown command 'switch' (try help)\n");
+  EXPECT_EQ(unknown.text, "unknown command 'swap' (try help)\n");
+  const Reply no_such = run("switch other");
+  EXPECT_FALSE(no_such.ok);
+  EXPECT_NE(no_such.text.find("no configuration named other"), std::string::npos) << no_such.text;
 
   const Reply blank = run("   # nothing");
   EXPECT_TRUE(blank.ok);

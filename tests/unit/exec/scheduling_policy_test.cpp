@@ -117,15 +117,15 @@ TEST(SchedulingPolicy, MufProtectsTheCriticalSetWhereRateMonotonicDoesNot) {
 }
 
 TEST(SchedulingPolicy, MufOrdersByCriticalityThenDeadlineThenUserPriority) {
-  // Same period, so the same deadline at every release: a and b fit the critical set (0.5 +
-  // 0.4), c does not (1.2); b's user priority puts it before a; c's higher one cannot lift it
-  // above the critical set. Under RM and EDF the ties fall to file order. c starts at 9, still
-  // before its deadline, and misses it.
+  // The critical set takes the shortest periods first (ties: higher user priority first): b and
+  // a fit (0.4 + 0.5), c does not (1.05). Between a and b, whose deadlines tie, b's user priority
+  // wins; c's higher one cannot lift it above the critical set. Under RM and EDF the ties fall
+  // to file order, and c's longer period or later deadline puts it last.
   const std::string tasks =
       "\ncpus: [0]\ntasks:\n"
       "  - {name: a, module: tracer, period: 10ms, virtual_exec: 5ms, criticality: soft}\n"
       "  - {name: b, module: tracer, period: 10ms, virtual_exec: 4ms, criticality: soft, priority: 5}\n"
-      "  - {name: c, module: tracer, period: 10ms, virtual_exec: 3ms, criticality: soft, priority: 9}\n";
+      "  - {name: c, module: tracer, period: 20ms, virtual_exec: 3ms, criticality: soft, priority: 9}\n";
   ASSERT_TRUE(run("subsystem: s\nscheduler: muf" + tasks, 10 * kMs));
   EXPECT_EQ(starts(), "b@0 a@4 c@9");
   ASSERT_TRUE(run("subsystem: s\nscheduler: edf" + tasks, 10 * kMs));

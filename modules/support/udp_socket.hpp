@@ -12,7 +12,7 @@
 #include <cstdint>
 #include <string>
 
-namespace chimera::modules::net {
+namespace chimera::modules {
 
 struct UdpSocket {
   int fd = -1;                  // -1 when binding failed
@@ -52,4 +52,4 @@ inline UdpSocket bind_udp(const std::string& address, double port) {
   return s;
 }
 
-}  // namespace chimera::modules::net
+}  // namespace chimera::modules

@@ -1,0 +1,145 @@
+// chimera analyze FILE [--config NAME] [--wcet-from PROFILE] [--overhead DURATION]:
+// schedulability per CPU under the file's scheduler (contract section 2, docs/scheduling.md).
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include "chimera/analysis/cpu_assignment.hpp"
+#include "chimera/analysis/report.hpp"
+#include "chimera/analysis/schedulability.hpp"
+#include "chimera/analysis/task_models.hpp"
+#include "chimera/analysis/wcet_profile.hpp"
+#include "chimera/config/loader.hpp"
+#include "chimera/config/verify.hpp"
+#include "chimera/control/timing_table.hpp"
+#include "chimera/module/registry.hpp"
+#include "commands.hpp"
+#include "exit_codes.hpp"
+#include "load_file.hpp"
+#include "measure.hpp"
+
+namespace chimera::cli {
+namespace {
+
+using analysis::TaskModel;
+using analysis::WcetProfile;
+
+// Whether analysis needs a C that neither the file nor the profile gives.
+bool needs_measuring(const std::vector<TaskModel>& models) {
+  return std::any_of(models.begin(), models.end(), [](const TaskModel& m) {
+    return !analysis::is_background(m) && m.wcet_source == analysis::WcetSource::kUnknown;
+  });
+}
+
+// Prints the violations of the configurations to analyse; true when there are none.
+bool legal(const SubsystemSpec& spec, const std::optional<std::string>& config) {
+  const auto violations = verify_subsystem(resolve_subsystem(spec, Registry::global()), config);
+  for (const auto& v : violations) fmt::print(stderr, "{}: {}\n", spec.file, v.message);
+  if (violations.empty()) return true;
+  fmt::print(stderr, "{}: only legal configurations can be analysed (chimera verify says more)\n", spec.file);
+  return false;
+}
+
+struct Analysed {
+  bool ok = true;  // false: it could not be analysed (the message is printed)
+  bool feasible = false;
+};
+
+Analysed analyse_one(const SubsystemSpec& spec, const ConfigurationSpec& config, const WcetProfile* profile,
+                     const analysis::AnalysisOptions& options) {
+  // The CPUs come from what `chimera run` knows too (the file's wcet: and cpu:), so that the
+  // assignment shown is the one a run makes; profile and measurements only refine the analysis.
+  const auto cpus = analysis::allowed_cpus(spec, static_cast<int>(::sysconf(_SC_NPROCESSORS_ONLN)));
+  const auto file_cpu = analysis::assign_subsystem_cpus(spec, cpus, options);
+
+  std::optional<WcetProfile> measured;
+  std::string note;
+  if (needs_measuring(analysis::task_models(spec, config.tasks, profile))) {
+    const std::int64_t length = measurement_length_ns(spec, config.name);
+    auto run = measure_profile(spec, config.name, ClockKind::kVirtual, length, kMeasureRuns, analysis::kMeasuredMargin);
+    if (!run) {
+      fmt::print(stderr, "{}: configuration '{}': cannot run it to measure execution times: {}\n", spec.file,
+                 config.name, run.error().message);
+      return Analysed{false, false};
+    }
+    measured = *std::move(run);
+    note = fmt::format(
+        "measured: C = {} x the longest cycle, the least of {} runs of {} on the virtual clock "
+        "(chimera profile and --wcet-from give better figures)",
+        analysis::kMeasuredMargin, kMeasureRuns, format_period(length));
+  }
+  const auto models = analysis::task_models(spec, config.tasks, profile, measured ? &*measured : nullptr);
+  std::vector<int> cpu_of;
+  cpu_of.reserve(models.size());
+  for (const auto& m : models) cpu_of.push_back(file_cpu[static_cast<std::size_t>(m.file_index)]);
+  const auto result = analysis::analyse_configuration(models, cpu_of, cpus, spec.scheduler, options);
+  const analysis::ReportContext context{spec.file, config.name, spec.scheduler, options, note};
+  std::fputs(analysis::format_report(context, models, result).c_str(), stdout);
+  return Analysed{true, result.feasible};
+}
+
+}  // namespace
+
+CLI::App* add_analyze_command(CLI::App& app, AnalyzeArgs& args) {
+  auto* cmd = app.add_subcommand("analyze", "Schedulability per CPU under the file's scheduler");
+  cmd->add_option("FILE", args.file, "subsystem file (YAML)")->required();
+  cmd->add_option_function<std::string>(
+      "--config", [&args](const std::string& name) { args.config = name; }, "analyse only this configuration");
+  cmd->add_option_function<std::string>(
+      "--wcet-from", [&args](const std::string& path) { args.wcet_from = path; },
+      "execution budgets from this profile (written by chimera profile)");
+  cmd->add_option_function<std::string>(
+      "--overhead",
+      [&args](const std::string& text) {
+        auto ns = parse_duration_ns(text);
+        if (!ns) throw CLI::ValidationError("--overhead", ns.error().message);
+        args.overhead_ns = *ns;
+      },
+      "framework overhead added to every C, per cycle (default 1us)");
+  return cmd;
+}
+
+int analyze_command(const AnalyzeArgs& args) {
+  auto spec = load_file(args.file, args.config);
+  if (!spec) return kExitInvalid;
+  std::optional<WcetProfile> profile;
+  if (args.wcet_from) {
+    auto read = analysis::read_wcet_profile_file(*args.wcet_from);
+    if (read) {
+      if (auto matches = analysis::check_profile_matches(*read, *spec); !matches) read = matches.error();
+    }
+    if (!read) {
+      fmt::print(stderr, "{}\n", read.error().message);
+      return kExitInvalid;
+    }
+    profile = *std::move(read);
+  }
+  if (!legal(*spec, args.config)) return kExitInvalid;
+
+  const analysis::AnalysisOptions options{.overhead_ns = args.overhead_ns};
+  std::size_t analysed = 0;
+  std::size_t infeasible = 0;
+  for (const auto& config : spec->configurations) {
+    if (args.config && config.name != *args.config) continue;
+    if (analysed > 0) std::fputs("\n", stdout);
+    const Analysed a = analyse_one(*spec, config, profile ? &*profile : nullptr, options);
+    if (!a.ok) return kExitInvalid;
+    ++analysed;
+    infeasible += a.feasible ? 0 : 1;
+  }
+  if (infeasible == 0) {
+    fmt::print("{}: {} configuration{} feasible\n", args.file, analysed, analysed == 1 ? "" : "s");
+    return kExitOk;
+  }
+  fmt::print("{}: {} of {} configuration{} not feasible\n", args.file, infeasible, analysed, analysed == 1 ? "" : "s");
+  return kExitFailed;
+}
+
+}  // namespace chimera::cli

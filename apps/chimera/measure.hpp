@@ -1,0 +1,33 @@
+#pragma once
+// Measuring execution times by running a configuration: `chimera analyze` does it on the virtual
+// clock for tasks whose C nothing else gives; a profiling command can do it on the real clock.
+
+#include <cstdint>
+#include <string>
+
+#include "chimera/analysis/wcet_profile.hpp"
+#include "chimera/config/subsystem.hpp"
+#include "chimera/core/result.hpp"
+#include "chimera/exec/subsystem.hpp"
+
+namespace chimera::cli {
+
+/// How long `chimera analyze` runs a configuration to measure it: 20 periods of its slowest
+/// task, at least 1 s, of simulated time (on the virtual clock a second of a 1 kHz task takes a
+/// few milliseconds).
+std::int64_t measurement_length_ns(const SubsystemSpec& spec, const std::string& configuration);
+
+/// How many runs `chimera analyze` makes of each configuration it measures.
+inline constexpr int kMeasureRuns = 5;
+
+/// Runs `configuration` of `spec` `runs` times for `for_ns` on `clock` (its own shared memory,
+/// beside any running instance) and returns, per task that ran a cycle, the least over the runs
+/// of its longest cycle, x `margin`, as the budget (analysis::measured_entry()). On the virtual
+/// clock every run takes the same inputs down the same paths, so a task's slowest cycle is there
+/// in each run, while the machine's stalls (another process taking the CPU mid-cycle) are not
+/// C and rarely strike every run. A task that fails while measured is reported as a warning;
+/// its cycles still count. Not real-time safe.
+Result<analysis::WcetProfile> measure_profile(const SubsystemSpec& spec, const std::string& configuration,
+                                              ClockKind clock, std::int64_t for_ns, int runs, double margin);
+
+}  // namespace chimera::cli

@@ -1,0 +1,116 @@
+// Dynamic reconfiguration on the real clock: 10,000 switches at 1 kHz between two producers of
+// one variable, with a consumer that stays ON (the robot interface's place), at real-time
+// priorities as `chimera run` runs them.
+//
+//   switch_bench [--quick] [--out FILE] [--samples-dir DIR] [--switches N]
+//
+// Keys: switch_lost_cycles (the staying task's releases that did not run, plus its cycles that
+// did not get the value of their own release from whichever producer was on), and
+// switch_commit_latency_ns_p50 / _p99 (from the request to the commit at a cycle boundary).
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "chimera/config/loader.hpp"
+#include "chimera/exec/subsystem.hpp"
+#include "common/bench_util.hpp"
+
+int main(int argc, char** argv) {
+  using namespace chimera;
+  using namespace chimera::bench;
+  const Args args = Args::parse(argc, argv);
+  int switches = args.quick ? 1000 : 10'000;
+  for (std::size_t i = 0; i + 1 < args.rest.size(); ++i)
+    if (args.rest[i] == "--switches") switches = std::stoi(args.rest[i + 1]);
+
+  // Soft tasks with late: run: a late cycle on a shared machine must neither send a task to
+  // ERROR nor be skipped; lateness is not what this measures, lost cycles are.
+  const std::string yaml = fmt::format(R"(subsystem: bench_switch_{}
+tasks:
+  - {{name: a, module: bench_stamper, frequency: 1kHz, criticality: soft, late: run}}
+  - {{name: b, module: bench_stamper, frequency: 1kHz, criticality: soft, late: run}}
+  - {{name: robot, module: bench_stamp_check, frequency: 1kHz, criticality: soft, late: run}}
+configurations:
+  with_a: [a, robot]
+  with_b: [b, robot]
+)",
+                                       ::getpid());
+  auto spec = load_subsystem_text(yaml, "switch_bench.yaml", Registry::global());
+  if (!spec) {
+    std::fprintf(stderr, "%s\n", spec.error().message.c_str());
+    return 1;
+  }
+  RunOptions options;
+  options.clock = ClockKind::kReal;
+  auto sub = Subsystem::create(*spec, Registry::global(), options);
+  if (!sub) {
+    std::fprintf(stderr, "%s\n", sub.error().message.c_str());
+    return 1;
+  }
+  Subsystem& s = **sub;
+  if (auto r = s.start(); !r) {
+    std::fprintf(stderr, "%s\n", r.error().message.c_str());
+    return 1;
+  }
+  // Create b once, so that every measured switch is a commit between existing tasks.
+  if (auto r = s.switch_to("with_b"); !r || !s.switch_to("with_a")) {
+    std::fprintf(stderr, "warm-up switch failed\n");
+    return 1;
+  }
+  s.run_for(50'000'000);
+  auto robot_of = [&] {
+    for (const auto& t : s.snapshot())
+      if (t.name == "robot") return t.stats;
+    return TaskStatsSnapshot{};
+  };
+  const TaskStatsSnapshot before = robot_of();
+  const double stale_before = s.get("stale")->at(0);
+  const std::int64_t t0 = s.now_ns();
+  std::vector<std::uint32_t> commit;
+  commit.reserve(static_cast<std::size_t>(switches));
+  int failed = 0;
+  for (int i = 0; i < switches; ++i) {
+    auto r = s.switch_to(i % 2 == 0 ? "with_b" : "with_a");
+    if (!r) {
+      ++failed;
+      continue;
+    }
+    commit.push_back(static_cast<std::uint32_t>(r->committed_ns - r->requested_ns));
+  }
+  s.run_for(20'000'000);  // the last switch's producer runs a few cycles
+  const std::int64_t t1 = s.now_ns();
+  const TaskStatsSnapshot after = robot_of();
+  const double stale = s.get("stale")->at(0) - stale_before;
+  s.stop();
+
+  // The robot released every 1 ms from t0 to t1: that many cycles, each with a fresh value.
+  const double expected = static_cast<double>(t1 - t0) / 1e6;
+  const double ran = static_cast<double>(after.cycles - before.cycles);
+  const double missing = std::max(0.0, expected - ran - 1.0);  // one release of slack at either edge
+  Fragment out;
+  out.result("switch_lost_cycles", missing + stale);
+  std::vector<std::uint32_t> sorted = commit;
+  auto stats = summary(sorted);
+  if (!commit.empty()) {
+    out.result("switch_commit_latency_ns_p50", stats["p50"].get<double>());
+    out.result("switch_commit_latency_ns_p99", stats["p99"].get<double>());
+  }
+  auto& d = out.details();
+  d["switches"] = switches;
+  d["switches_failed"] = failed;
+  d["seconds"] = static_cast<double>(t1 - t0) * 1e-9;
+  d["robot_cycles"] = ran;
+  d["robot_cycles_expected"] = expected;
+  d["robot_releases_not_run"] = missing;
+  d["robot_cycles_without_fresh_value"] = stale;
+  d["robot_missed_deadlines"] = after.missed - before.missed;
+  d["robot_order_timeouts"] = after.order_timeouts - before.order_timeouts;
+  d["commit_latency_ns"] = stats;
+  out.samples(args, "switch_commit_latency", commit);
+  return out.write(args);
+}

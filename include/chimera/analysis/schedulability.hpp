@@ -1,0 +1,89 @@
+#pragma once
+// Schedulability of one CPU's tasks, and of a whole configuration, under the file's scheduler:
+// rm and dm by exact response-time analysis, edf by the utilisation or processor-demand test,
+// muf by the feasibility of its critical set. docs/scheduling.md explains each with numbers.
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "chimera/analysis/processor_demand.hpp"
+#include "chimera/analysis/task_model.hpp"
+#include "chimera/config/subsystem.hpp"
+
+namespace chimera::analysis {
+
+enum class Verdict {
+  kMeets,        // every job meets its deadline
+  kCanMiss,      // some job can miss, or nothing bounds the task (the reason says which)
+  kNoGuarantee,  // MUF: not in the critical set, so by design nothing is promised
+  kBackground,   // aperiodic without a server: runs when nothing else does, no guarantee
+};
+
+std::string_view verdict_name(Verdict verdict);
+
+/// Why an EDF test failed, in one line ("overloaded: U = 1.100 > 1"); "" if it passed.
+std::string edf_failure_reason(const EdfTest& test);
+
+/// Which test decided a CPU.
+enum class CpuTest {
+  kNone,                // no task with a period on the CPU
+  kResponseTime,        // rm, dm
+  kEdfUtilisation,      // edf, every D >= T
+  kEdfProcessorDemand,  // edf, some D < T
+  kMufCriticalSet,      // muf: the critical set by EDF's test
+};
+
+struct TaskResult {
+  std::size_t index = 0;  // into the tasks given
+  /// The analysed C (with the overhead, for a server its budget plus one job), T and D;
+  /// nullopt for a background task or an unknown C.
+  std::optional<Demand> demand;
+  Verdict verdict = Verdict::kCanMiss;
+  /// rm, dm: the worst-case response time (when the reason says "at least", a lower bound past the
+  /// deadline). edf, muf: the deadline, an upper bound (response_is_bound). 0: none.
+  std::int64_t response_ns = 0;
+  bool response_is_bound = false;
+  bool critical = false;  // muf: in the critical set
+  std::string reason;     // one line; empty when the task meets its deadline by the CPU's test
+};
+
+struct CpuResult {
+  int cpu = -1;
+  SchedulerKind scheduler = SchedulerKind::kRm;
+  /// In the order the scheduler favours them: priority (rm, dm), deadline (edf), critical set
+  /// first in admission order (muf); background tasks last.
+  std::vector<TaskResult> tasks;
+  int periodic = 0;                  // tasks with a period (servers included): the bound's n
+  bool utilisation_complete = true;  // false: some C is unknown and `utilisation` leaves it out
+  double utilisation = 0;            // sum C/T of the periodic tasks, overhead included
+  double ll_bound = 1;               // Liu and Layland for `periodic` tasks
+  bool implicit_deadlines = true;    // every D == T (where the bound applies, under rm)
+  CpuTest test = CpuTest::kNone;
+  /// edf: the test of all tasks; muf: of the critical set's tasks that fit.
+  EdfTest edf;
+  /// Every task meets its deadline, but for muf's non-critical tasks and background tasks.
+  bool feasible = true;
+};
+
+/// Analyses the tasks of one CPU (their `cpu` field is not looked at). Not real-time safe.
+[[nodiscard]] CpuResult analyse_cpu(std::span<const TaskModel> tasks, SchedulerKind scheduler,
+                                    const AnalysisOptions& options = {});
+
+struct ConfigurationResult {
+  std::vector<int> cpu_of;      // per task given: the CPU it runs on
+  std::vector<CpuResult> cpus;  // one per CPU, by CPU number; TaskResult::index counts the tasks given
+  bool feasible = true;
+};
+
+/// Analyses every CPU of `cpus` (and any other that `cpu_of` names) with the tasks `cpu_of` puts
+/// there. Not real-time safe.
+[[nodiscard]] ConfigurationResult analyse_configuration(std::span<const TaskModel> tasks, std::span<const int> cpu_of,
+                                                        std::span<const int> cpus, SchedulerKind scheduler,
+                                                        const AnalysisOptions& options = {});
+
+}  // namespace chimera::analysis

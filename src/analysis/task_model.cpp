@@ -1,0 +1,22 @@
+#include "chimera/analysis/task_model.hpp"
+
+namespace chimera::analysis {
+
+std::string_view wcet_source_name(WcetSource source) {
+  switch (source) {
+    case WcetSource::kUnknown: return "unknown";
+    case WcetSource::kFile: return "file";
+    case WcetSource::kProfile: return "profile";
+    case WcetSource::kMeasured: return "measured";
+    case WcetSource::kVirtual: return "virtual_exec";
+  }
+  return "?";
+}
+
+std::optional<Demand> demand_of(const TaskModel& task, const AnalysisOptions& options) {
+  if (is_background(task) || !wcet_known(task)) return std::nullopt;
+  const std::int64_t overrun = task.server ? task.job_wcet_ns : 0;
+  return Demand{task.wcet_ns + overrun + options.overhead_ns, task.period_ns, relative_deadline(task)};
+}
+
+}  // namespace chimera::analysis

@@ -1,0 +1,54 @@
+#include "chimera/analysis/task_models.hpp"
+
+#include <algorithm>
+
+namespace chimera::analysis {
+namespace {
+
+// C for one cycle (for a server: one job) and where it came from.
+std::pair<std::int64_t, WcetSource> execution_time(const TaskSpec& t, const WcetProfile* profile,
+                                                   const WcetProfile* measured) {
+  if (t.wcet_ns) return {*t.wcet_ns, WcetSource::kFile};
+  if (profile != nullptr)
+    if (const ProfileEntry* e = profile->find(t.name)) return {e->wcet_ns, WcetSource::kProfile};
+  if (measured != nullptr)
+    if (const ProfileEntry* e = measured->find(t.name)) return {e->wcet_ns, WcetSource::kMeasured};
+  if (t.virtual_exec_ns > 0) return {t.virtual_exec_ns, WcetSource::kVirtual};  // a simulated cost, last
+  return {0, WcetSource::kUnknown};
+}
+
+}  // namespace
+
+std::vector<TaskModel> task_models(const SubsystemSpec& spec, std::span<const std::string> task_names,
+                                   const WcetProfile* profile, const WcetProfile* measured) {
+  std::vector<TaskModel> models;
+  for (std::size_t i = 0; i < spec.tasks.size(); ++i) {
+    const TaskSpec& t = spec.tasks[i];
+    if (std::find(task_names.begin(), task_names.end(), t.name) == task_names.end()) continue;
+    TaskModel m;
+    m.name = t.name;
+    const auto [c, source] = execution_time(t, profile, measured);
+    m.wcet_ns = c;
+    m.wcet_source = source;
+    m.period_ns = t.period_ns.value_or(0);
+    m.deadline_ns = t.deadline_ns;
+    m.hard = t.criticality == Criticality::kHard;
+    m.user_priority = t.priority;
+    m.cpu = t.cpu.value_or(-1);
+    m.file_index = static_cast<int>(i);
+    if (t.server) {
+      // A served aperiodic task: its budget every server period, plus the one job that may run
+      // over it (docs/scheduling.md); the C found above is that longest job.
+      m.server = true;
+      m.wcet_ns = t.server->budget_ns;
+      m.job_wcet_ns = c;
+      m.period_ns = t.server->period_ns;
+    }
+    // late: changes how a run treats the task, not what analysis assumes (a skipped release
+    // only lightens the load); virtual_exec counts only where nothing better is known.
+    models.push_back(std::move(m));
+  }
+  return models;
+}
+
+}  // namespace chimera::analysis

@@ -1,0 +1,60 @@
+#include <poll.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <cstring>
+
+#include "chimera/exec/clock.hpp"
+#include "futex.hpp"
+#include "real_worker.hpp"
+
+namespace chimera {
+
+void TaskThread::main() {
+  for (Worker* m : members) m->self.store(pthread_self(), std::memory_order_relaxed);  // see job_active
+  // Touch the stack once so that its pages are resident before the first cycle.
+  std::array<char, std::size_t{64} * 1024> prefault;  // NOLINT(cppcoreguidelines-pro-type-member-init): written next
+  std::memset(prefault.data(), 0, prefault.size());
+  asm volatile("" : : "r"(prefault.data()) : "memory");  // keeps the compiler from dropping the writes
+
+  if (members.size() != 1 || members.front()->task->periodic()) {
+    run_periodic_members();
+    return;
+  }
+  // An aperiodic task sleeps in poll() on its event source and its eventfd bell.
+  Worker& w = *members.front();
+  for (;;) {
+    (void)w.take_mail();
+    if (exiting.load(std::memory_order_relaxed)) return;  // its own store, in take_mail()
+    if (w.task->state() != TaskState::kOn) {
+      pollfd p{w.bell_fd, POLLIN, 0};
+      (void)::poll(&p, 1, -1);
+      std::uint64_t drained = 0;
+      (void)!::read(w.bell_fd, &drained, sizeof(drained));
+      continue;
+    }
+    w.run_aperiodic();
+  }
+}
+
+void TaskThread::run_periodic_members() {
+  for (;;) {
+    // Read the bell before the mail: a mail posted after this read changes the bell, so the
+    // wait below cannot miss it.
+    const std::uint32_t rung = bell.load(std::memory_order_acquire);  // acquire: pairs with the poster
+    for (Worker* m : members) (void)m->take_mail();
+    if (exiting.load(std::memory_order_relaxed)) return;  // its own store, in take_mail()
+    std::int64_t earliest = Worker::kNever;
+    for (Worker* m : members) earliest = std::min(earliest, m->prepare());
+    if (monotonic_ns() < earliest) {
+      detail::futex_wait(bell, rung, earliest == Worker::kNever ? -1 : earliest);
+      continue;  // mail, a spurious wake, or a release: the loop tells which
+    }
+    // The members' releases that have come, in data-flow order (the members' order).
+    for (Worker* m : members)
+      if (m->prepare() <= monotonic_ns()) m->act();
+  }
+}
+
+}  // namespace chimera

@@ -1,0 +1,121 @@
+// CPU assignment: pinned tasks stay, the others worst-fit decreasing with a schedulability check,
+// unknown shares spread evenly.
+
+#include "chimera/analysis/cpu_assignment.hpp"
+
+#include <vector>
+
+#include <gtest/gtest.h>
+
+namespace chimera::analysis {
+namespace {
+
+constexpr AnalysisOptions kNoOverhead{.overhead_ns = 0};
+
+TaskModel task(const char* name, std::int64_t c, std::int64_t t, int file_index, int cpu = -1) {
+  return TaskModel{.name = name, .wcet_ns = c, .period_ns = t, .cpu = cpu, .file_index = file_index};
+}
+
+TEST(AssignCpus, WorstFitDecreasingBalancesTheLoad) {
+  // Utilisations 0.3, 0.6, 0.4, 0.5 (file order). Largest first, each on the least-loaded CPU:
+  // 0.6 -> 0, 0.5 -> 1, 0.4 -> 1 (0.5 < 0.6), 0.3 -> 0: 0.9 and 0.9. First fit would have
+  // filled CPU 0 to 1.0 and left 0.8 on CPU 1.
+  const std::vector<TaskModel> tasks{task("a", 3, 10, 0), task("b", 6, 10, 1), task("c", 4, 10, 2),
+                                     task("d", 5, 10, 3)};
+  EXPECT_EQ(assign_cpus(tasks, std::vector<int>{0, 1}, SchedulerKind::kEdf, kNoOverhead),
+            (std::vector<int>{0, 0, 1, 1}));
+}
+
+TEST(AssignCpus, PinnedTasksStayAndCountAsLoad) {
+  const std::vector<TaskModel> tasks{task("pinned", 5, 10, 0, 1), task("x", 4, 10, 1), task("y", 3, 10, 2),
+                                     task("far", 1, 10, 3, 7)};
+  // x (0.4) -> CPU 0 (empty), y (0.3) -> CPU 0 (0.4 < 0.5); `far` keeps a CPU the list lacks.
+  EXPECT_EQ(assign_cpus(tasks, std::vector<int>{0, 1}, SchedulerKind::kRm, kNoOverhead),
+            (std::vector<int>{1, 0, 0, 7}));
+}
+
+TEST(AssignCpus, SkipsALessLoadedCpuWhereTheTaskWouldMiss) {
+  // CPU 1 holds (34, 70), U = 0.486; CPU 0 holds (50, 100), U = 0.5. The new (100, 200) would
+  // miss on CPU 1 under rm (R: 134 -> 168 -> 202 > 200) but fits CPU 0 exactly (harmonic, U = 1).
+  const std::vector<TaskModel> tasks{task("y", 50, 100, 0, 0), task("x", 34, 70, 1, 1), task("z", 100, 200, 2)};
+  EXPECT_EQ(assign_cpus(tasks, std::vector<int>{0, 1}, SchedulerKind::kRm, kNoOverhead), (std::vector<int>{0, 1, 0}));
+}
+
+TEST(AssignCpus, ShortDeadlinesUnderRateMonotonicGetTheExactCheck) {
+  // urgent (1, T 200, D 2) has a density of only 0.5, yet under rm the pinned (2, 10) on the
+  // less-loaded CPU 0 outranks it: 1 + 2 = 3 > 2. On CPU 1 it outranks the pinned (100, 400).
+  // Under dm it outranks both, and CPU 0 is fine.
+  std::vector<TaskModel> tasks{task("ctl", 2, 10, 0, 0), task("slow", 100, 400, 1, 1), task("urgent", 1, 200, 2)};
+  tasks[2].deadline_ns = 2;
+  EXPECT_EQ(assign_cpus(tasks, std::vector<int>{0, 1}, SchedulerKind::kRm, kNoOverhead), (std::vector<int>{0, 1, 1}));
+  EXPECT_EQ(assign_cpus(tasks, std::vector<int>{0, 1}, SchedulerKind::kDm, kNoOverhead), (std::vector<int>{0, 1, 0}));
+}
+
+TEST(AssignCpus, NowhereFeasibleGoesToTheLeastLoaded) {
+  const std::vector<TaskModel> tasks{task("a", 9, 10, 0), task("b", 8, 10, 1), task("c", 5, 10, 2)};
+  EXPECT_EQ(assign_cpus(tasks, std::vector<int>{0, 1}, SchedulerKind::kEdf, kNoOverhead), (std::vector<int>{0, 1, 1}));
+}
+
+TEST(AssignCpus, UnknownExecutionTimesAreSpreadEvenly) {
+  std::vector<TaskModel> tasks(5);
+  for (int i = 0; i < 5; ++i) tasks[i] = task("u", 0, 10 + i, i);
+  EXPECT_EQ(assign_cpus(tasks, std::vector<int>{0, 1}, SchedulerKind::kMuf), (std::vector<int>{0, 1, 0, 1, 0}));
+  // Pinned on CPU 0: the next goes to CPU 1.
+  tasks[0].cpu = 0;
+  EXPECT_EQ(assign_cpus(tasks, std::vector<int>{0, 1}, SchedulerKind::kMuf), (std::vector<int>{0, 1, 0, 1, 0}));
+  // Pinned on CPU 1: the next goes to CPU 0, then a tie of one each goes to the lower number.
+  tasks[0].cpu = 1;
+  EXPECT_EQ(assign_cpus(tasks, std::vector<int>{0, 1}, SchedulerKind::kMuf), (std::vector<int>{1, 0, 0, 1, 0}));
+}
+
+TEST(AssignCpus, UnknownSharesPreferTheLessLoadedCpuOnATie) {
+  // A known 0.8 goes on CPU 0; the first unknown then on CPU 1, the second on CPU 0 (fewest
+  // unknowns first), then background tasks the same way.
+  const std::vector<TaskModel> tasks{task("k", 8, 10, 0), task("u1", 0, 10, 1), task("u2", 0, 20, 2),
+                                     task("bg", 1, 0, 3)};
+  EXPECT_EQ(assign_cpus(tasks, std::vector<int>{0, 1}, SchedulerKind::kRm, kNoOverhead),
+            (std::vector<int>{0, 1, 0, 1}));
+}
+
+TEST(AssignCpus, OrderOfTheCpuListDoesNotMatter) {
+  const std::vector<TaskModel> tasks{task("a", 3, 10, 0), task("b", 6, 10, 1), task("c", 4, 10, 2)};
+  EXPECT_EQ(assign_cpus(tasks, std::vector<int>{3, 1}, SchedulerKind::kEdf, kNoOverhead),
+            assign_cpus(tasks, std::vector<int>{1, 3}, SchedulerKind::kEdf, kNoOverhead));
+  // b (0.6) on the lower number, c (0.4) on the other, a (0.3) where c is.
+  EXPECT_EQ(assign_cpus(tasks, std::vector<int>{3, 1}, SchedulerKind::kEdf, kNoOverhead), (std::vector<int>{3, 1, 3}));
+}
+
+TEST(AssignCpus, NoCpusLeavesUnpinnedTasksUnassigned) {
+  const std::vector<TaskModel> tasks{task("a", 3, 10, 0), task("b", 6, 10, 1, 0)};
+  EXPECT_EQ(assign_cpus(tasks, std::vector<int>{}, SchedulerKind::kRm), (std::vector<int>{-1, 0}));
+}
+
+TEST(AssignSubsystemCpus, EveryTaskOfTheFileFromItsWcetAndCpu) {
+  // Three tasks in two configurations: all are placed, in file order, as assign_cpus() would.
+  SubsystemSpec spec;
+  spec.scheduler = SchedulerKind::kEdf;
+  for (const char* name : {"a", "b", "c"}) {
+    TaskSpec t;
+    t.name = name;
+    t.period_ns = 10'000'000;
+    t.deadline_ns = 10'000'000;
+    spec.tasks.push_back(t);
+  }
+  spec.tasks[0].wcet_ns = 6'000'000;
+  spec.tasks[1].wcet_ns = 3'000'000;
+  spec.tasks[2].cpu = 0;  // unknown C, pinned
+  spec.configurations.push_back(ConfigurationSpec{"one", {"a"}, {}});
+  spec.configurations.push_back(ConfigurationSpec{"two", {"b", "c"}, {}});
+  const std::vector<int> cpus{0, 1};
+  EXPECT_EQ(assign_subsystem_cpus(spec, cpus), (std::vector<int>{0, 1, 0}));
+}
+
+TEST(AllowedCpus, TheFilesListOrEveryOnlineCpu) {
+  SubsystemSpec spec;
+  EXPECT_EQ(allowed_cpus(spec, 3), (std::vector<int>{0, 1, 2}));
+  spec.cpus = {2, 5};
+  EXPECT_EQ(allowed_cpus(spec, 3), (std::vector<int>{2, 5}));
+}
+
+}  // namespace
+}  // namespace chimera::analysis
