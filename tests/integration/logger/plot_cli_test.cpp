@@ -96,7 +96,7 @@ TEST_F(PlotCliTest, TheDemosPathALoggedRunOfFigure4ThenItsPlot) {
   EXPECT_TRUE(header.starts_with("t,theta_d[0],")) << header;
   std::size_t rows = 0;
   for (std::string line; std::getline(csv, line);) ++rows;
-  EXPECT_EQ(rows, 200u) << "2 s of the logger's 10 ms cycles";
+  EXPECT_EQ(rows, 2000u) << "2 s of the logger's 1 ms cycles";
   const auto plot = run_chimera(dir_, "plot " + quoted(dir_.file("fig4.csv")) + " --vars theta_d,theta_m");
   EXPECT_EXIT_CODE(plot, 0);
   EXPECT_TRUE(is_png(dir_.file("fig4.png")));
