@@ -159,6 +159,7 @@ PROGRAMS = [
     Program("many_tasks", "many_tasks", "1,000 tasks at 100 Hz", ["tasks_1000_at_100hz_cpu_percent"]),
     Program("virtual_clock", "apps/chimera/chimera", "Figure 4 on the virtual clock",
             ["virtual_clock_speedup_fig4"], run=run_virtual_clock),
+    Program("policies", "policy_bench", "rm, edf and muf on the real clock: deadlines missed", []),
     Program("switch", "switch_bench", "10,000 switches at 1 kHz on the real clock",
             ["switch_lost_cycles", "switch_commit_latency_ns_p50", "switch_commit_latency_ns_p99"],
             timeout_s=600),

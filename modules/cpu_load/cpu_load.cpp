@@ -5,14 +5,20 @@
 
 #include <cmath>
 #include <cstdint>
+#include <ctime>
 
-#include "chimera/exec/clock.hpp"
 #include "chimera/module/registry.hpp"
 
 namespace chimera::modules {
 namespace {
 
 std::int64_t ns_of(double seconds) { return static_cast<std::int64_t>(std::llround(seconds * 1e9)); }
+
+std::int64_t thread_cpu_ns() noexcept {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
 
 class CpuLoad final : public Module {
  public:
@@ -50,8 +56,9 @@ class CpuLoad final : public Module {
     if (timing_->virtual_clock) {
       consume_virtual_time(t);
     } else {
-      const std::int64_t until = monotonic_ns() + t;
-      while (monotonic_ns() < until) {
+      // Spin on the thread's own CPU clock: the load is `t` of CPU however often it is preempted.
+      const std::int64_t until = thread_cpu_ns() + t;
+      while (thread_cpu_ns() < until) {
       }
     }
     return Status::ok();

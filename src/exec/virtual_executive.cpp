@@ -195,6 +195,7 @@ void VirtualExecutive::advance_to(std::int64_t t) {
 }
 
 void VirtualExecutive::step() {
+  stepped_ns_ = now_ns_;
   refill_servers();
   for (const int r : running_)
     if (r >= 0 && slots_[static_cast<std::size_t>(r)].job.remaining_ns <= 0) finish(static_cast<std::size_t>(r));
@@ -242,8 +243,12 @@ Result<void> VirtualExecutive::signal(std::size_t task, Signal signal) {
     return r;
   }
   if (t.periodic() && s.next_release_ns < 0) {
+    // The first whole multiple of the period from now; if this instant's releases have already
+    // run (a switch a task asked for during them), the one after: its producer of this instant
+    // has already run it.
     const std::int64_t p = t.period_ns();
-    s.next_release_ns = (now_ns_ + p - 1) / p * p;  // the first whole multiple of the period from now
+    const std::int64_t from = now_ns_ == stepped_ns_ ? now_ns_ + 1 : now_ns_;
+    s.next_release_ns = (from + p - 1) / p * p;
     s.first_release_ns = s.next_release_ns;
     s.last_done_release_ns = -1;
   }

@@ -92,6 +92,7 @@ class VirtualExecutive {
   std::vector<int> running_;   // per CPU slot (index into plan_.cpu values via cpu_slot_): task or -1
   std::vector<int> cpu_slot_;  // per task: index into running_
   std::int64_t now_ns_ = 0;
+  std::int64_t stepped_ns_ = -1;  // the last instant whose releases were dispatched
 };
 
 }  // namespace chimera

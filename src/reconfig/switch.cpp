@@ -46,7 +46,7 @@ std::map<std::string, std::vector<double>> read_values(const GlobalTable& table,
 }  // namespace
 
 std::string describe(const SwitchRecord& r) {
-  std::string text = fmt::format("switch {} -> {} ({})", r.from, r.to, r.cause);
+  std::string text = fmt::format("at {}: switch {} -> {} ({})", format_duration(r.committed_ns), r.from, r.to, r.cause);
   auto part = [&](const char* what, const std::vector<std::string>& names) {
     if (!names.empty()) text += fmt::format("{} {} {}", text.back() == ')' ? ":" : ";", what, fmt::join(names, ", "));
   };

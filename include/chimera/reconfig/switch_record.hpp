@@ -20,8 +20,8 @@ struct SwitchRecord {
   bool flag_raised = false;          // the illegal-configuration flag was up while it lasted
 };
 
-/// One line: "switch standard -> near_singularity (requested by monitor): off ik; on dls, integ;
-/// created dls, integ; 1.20 ms".
+/// One line: "at 5.002 s: switch standard -> near_singularity (requested by monitor): off ik; on
+/// dls, integ; created dls, integ; committed after 1.00 ms, ...".
 std::string describe(const SwitchRecord& record);
 
 }  // namespace chimera

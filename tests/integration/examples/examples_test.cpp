@@ -17,6 +17,7 @@
 #include "chimera/config/loader.hpp"
 #include "chimera/exec/subsystem.hpp"
 #include "chimera/module/registry.hpp"
+#include "chimera/reconfig/switch_record.hpp"
 #include "cli/run_chimera.hpp"
 #include "kinematics/pose.hpp"
 #include "visual_servo/target_path.hpp"
@@ -111,19 +112,35 @@ double norm(const std::vector<double>& v) {
 }
 
 struct Tracking {
-  double initial_error = 0.0;      // m, tool to target at start
-  double worst_error = 0.0;        // m, after the first 2 s
-  double worst_error_at = 0.0;     // s
-  double rms_error = 0.0;          // m, after the first 2 s
-  double lowest_w = 1.0;           // manipulability
-  double lowest_w_at = 0.0;        // s
-  double fastest_theta_d = 0.0;    // rad/s, |d theta_d / dt| over a period (joint vector norm), after 2 s
-  double straightest_elbow = 0.0;  // rad, the elbow's closest approach to pi/2 (its distance)
+  double initial_error = 0.0;       // m, tool to target at start
+  double worst_error = 0.0;         // m, after the first 2 s
+  double worst_error_at = 0.0;      // s
+  double rms_error = 0.0;           // m, after the first 2 s
+  double lowest_w = 1.0;            // manipulability
+  double lowest_w_at = 0.0;         // s
+  double fastest_theta_d = 0.0;     // rad/s, |d theta_d / dt| over a period (joint vector norm), after 2 s
+  double fastest_theta_d_at = 0.0;  // s
+  double fastest_near = 0.0;        // rad/s, the same while the manipulability is below 0.045
+  double straightest_elbow = 0.0;   // rad, the elbow's closest approach to pi/2 (its distance)
 };
 
-Tracking track(const std::string& config, std::int64_t duration_ns) {
+// The file, with its singularity monitor silenced unless `switching`: then the configuration
+// given stays on, whatever the manipulability.
+SubsystemSpec visual_servo(bool switching) {
+  SubsystemSpec spec = load_example("visual_servo.yaml");
+  if (!switching)
+    for (auto& t : spec.tasks)
+      if (t.module == "singularity_monitor") {
+        t.params.set("enter", 1e-9);
+        t.params.set("leave", 1e9);
+      }
+  return spec;
+}
+
+Tracking track(const std::string& config, std::int64_t duration_ns, bool switching = false,
+               std::vector<SwitchRecord>* switches = nullptr) {
   Tracking out;
-  const SubsystemSpec spec = load_example("visual_servo.yaml");
+  const SubsystemSpec spec = visual_servo(switching);
   auto sub = start(spec, config);
   if (!sub) return out;
   const auto path = path_of(spec, "vision");
@@ -132,15 +149,21 @@ Tracking track(const std::string& config, std::int64_t duration_ns) {
   double sum_sq = 0.0;
   int samples = 0;
   auto previous = value_of(*sub, "theta_d");
+  double last_w = 1.0;
   for (std::int64_t t = kMs; t <= duration_ns; t += kMs) {
     sub->run_for(kMs);
     const auto theta_d = value_of(*sub, "theta_d");
     for (std::size_t i = 0; i < previous.size(); ++i) previous[i] = (theta_d[i] - previous[i]) / 1e-3;
-    if (t > 2000 * kMs) out.fastest_theta_d = std::max(out.fastest_theta_d, norm(previous));
+    if (last_w < 0.045) out.fastest_near = std::max(out.fastest_near, norm(previous));
+    if (t > 2000 * kMs && norm(previous) > out.fastest_theta_d) {
+      out.fastest_theta_d = norm(previous);
+      out.fastest_theta_d_at = static_cast<double>(t) * 1e-9;
+    }
     previous = theta_d;
     if (t % (10 * kMs) != 0) continue;
     const double seconds = static_cast<double>(t) * 1e-9;
     const double w = manipulability(value_of(*sub, "jacobian"));
+    last_w = w;
     if (w < out.lowest_w) {
       out.lowest_w = w;
       out.lowest_w_at = seconds;
@@ -157,14 +180,21 @@ Tracking track(const std::string& config, std::int64_t duration_ns) {
   }
   out.rms_error = std::sqrt(sum_sq / samples);
   for (const auto& task : sub->snapshot()) {
-    if (task.state != TaskState::kNotCreated) {
+    if (task.state != TaskState::kNotCreated && !switching) {
       EXPECT_EQ(task.state, TaskState::kOn) << task.name << ": " << task.last_error;
     }
+    // The robot and the tasks both configurations share never lose a cycle, switches or not.
+    if (task.name == "robot" || task.name == "fk") {
+      EXPECT_EQ(task.stats.cycles, static_cast<std::uint64_t>(duration_ns / kMs)) << task.name;
+    }
+    EXPECT_NE(task.state, TaskState::kError) << task.name << ": " << task.last_error;
   }
+  if (switches != nullptr) *switches = sub->switches();
   std::cout << config << ": tool to target " << out.initial_error * 1000 << " mm at start, then (after 2 s) worst "
             << out.worst_error * 1000 << " mm (at " << out.worst_error_at << " s), RMS " << out.rms_error * 1000
             << " mm; lowest manipulability " << out.lowest_w << " at " << out.lowest_w_at << " s, elbow within "
-            << out.straightest_elbow << " rad of straight; fastest theta_d " << out.fastest_theta_d << " rad/s\n";
+            << out.straightest_elbow << " rad of straight; fastest theta_d " << out.fastest_theta_d << " rad/s at "
+            << out.fastest_theta_d_at << " s, " << out.fastest_near << " rad/s near the singularity\n";
   return out;
 }
 
@@ -185,6 +215,39 @@ TEST(Examples, BothConfigurationsOfFigures8And9TrackTheTargetNearTheSingularityA
   // that the damped one does not.
   EXPECT_LT(damped.fastest_theta_d, 3.0);
   EXPECT_GT(standard.fastest_theta_d, 10.0 * damped.fastest_theta_d);
+}
+
+// The paper's dynamic reconfiguration (3.4) in the same run: the monitor asks for damped least
+// squares as the manipulability falls below 0.06 on the way to the straight elbow, and for the
+// exact inverse again once it is above 0.075. The switches come in pairs around the two passes
+// near the singular posture (at about 5 s and 15 s), the robot runs every cycle, and the joint
+// speeds the exact inverse would ask for near the singularity are never asked.
+TEST(Examples, Figures8And9SwitchNearTheSingularityAndBack) {
+  std::vector<SwitchRecord> switches;
+  const Tracking t = track("standard", 20'000 * kMs, /*switching=*/true, &switches);
+  ASSERT_EQ(switches.size(), 4U);
+  for (std::size_t i = 0; i < switches.size(); ++i) {
+    EXPECT_EQ(switches[i].cause, "requested by monitor");
+    EXPECT_EQ(switches[i].to, i % 2 == 0 ? "near_singularity" : "standard");
+    std::cout << describe(switches[i]) << "\n";
+  }
+  EXPECT_TRUE(switches[0].flag_raised) << "the first creates dls and integ";
+  EXPECT_FALSE(switches[2].flag_raised) << "the second pass finds them created";
+  const double first_in = static_cast<double>(switches[0].committed_ns) * 1e-9;
+  const double second_in = static_cast<double>(switches[2].committed_ns) * 1e-9;
+  EXPECT_GT(first_in, 2.0);
+  EXPECT_LT(first_in, 5.0);
+  EXPECT_GT(second_in, 12.0);
+  EXPECT_LT(second_in, 15.0);
+  EXPECT_LT(t.worst_error, 0.015);
+  EXPECT_LT(t.rms_error, 0.006);
+  // Near the singular posture (w < 0.045) the exact inverse alone asks for tens of rad/s; with the
+  // switches, damped least squares has taken over by then. (Away from it the exact inverse steps
+  // theta_d with each 30 ms frame of the camera: fast for a millisecond, and the robot's servo
+  // limits it; that is no singularity.)
+  EXPECT_LT(t.fastest_near, 3.0) << "damped least squares took over before the exact inverse ran away";
+  const Tracking alone = track("standard", 20'000 * kMs);
+  EXPECT_GT(alone.fastest_near, 10.0 * t.fastest_near);
 }
 
 TEST(Examples, Figure3JoinsTwoCamerasIntoALessNoisyPose) {

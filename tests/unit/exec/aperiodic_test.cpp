@@ -15,6 +15,7 @@
 
 #include "chimera/config/loader.hpp"
 #include "chimera/exec/subsystem.hpp"
+#include "support/run_subsystem.hpp"
 #include "support/trace_module.hpp"
 
 namespace chimera {
@@ -23,25 +24,10 @@ namespace {
 constexpr std::int64_t kMs = 1'000'000;
 
 std::unique_ptr<Subsystem> start(const std::string& yaml) {
-  auto spec = load_subsystem_text(yaml, "a.yaml", testing::scheduling_registry());
-  EXPECT_TRUE(spec.ok()) << (spec.ok() ? "" : spec.error().message);
-  if (!spec.ok()) return nullptr;
-  RunOptions o;
-  o.clock = ClockKind::kVirtual;
-  o.shm_suffix = testing::unique_suffix();
-  auto s = Subsystem::create(*spec, testing::scheduling_registry(), o);
-  EXPECT_TRUE(s.ok()) << (s.ok() ? "" : s.error().message);
-  if (!s.ok()) return nullptr;
-  EXPECT_TRUE((*s)->start().ok());
-  return std::move(*s);
+  return testing::start_subsystem(yaml, testing::scheduling_registry());
 }
 
-TaskStatsSnapshot stats_of(Subsystem& s, const std::string& task) {
-  for (const auto& t : s.snapshot())
-    if (t.name == task) return t.stats;
-  ADD_FAILURE() << "no task " << task;
-  return {};
-}
+TaskStatsSnapshot stats_of(Subsystem& s, const std::string& task) { return testing::task_of(s, task).stats; }
 
 /// A pipe whose read end the test hands to an fd_reader, filled with `bytes` bytes.
 struct Pipe {

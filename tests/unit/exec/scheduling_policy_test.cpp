@@ -8,6 +8,7 @@
 
 #include "chimera/config/loader.hpp"
 #include "chimera/exec/subsystem.hpp"
+#include "support/run_subsystem.hpp"
 #include "support/trace_module.hpp"
 
 namespace chimera {
@@ -17,18 +18,9 @@ constexpr std::int64_t kMs = 1'000'000;
 
 std::unique_ptr<Subsystem> run(const std::string& yaml, std::int64_t for_ns) {
   testing::trace().clear();
-  auto spec = load_subsystem_text(yaml, "sched.yaml", testing::scheduling_registry());
-  EXPECT_TRUE(spec.ok()) << (spec.ok() ? "" : spec.error().message);
-  if (!spec.ok()) return nullptr;
-  RunOptions o;
-  o.clock = ClockKind::kVirtual;
-  o.shm_suffix = testing::unique_suffix();
-  auto s = Subsystem::create(*spec, testing::scheduling_registry(), o);
-  EXPECT_TRUE(s.ok()) << (s.ok() ? "" : s.error().message);
-  if (!s.ok()) return nullptr;
-  EXPECT_TRUE((*s)->start().ok());
-  (*s)->run_for(for_ns);
-  return std::move(*s);
+  auto s = testing::start_subsystem(yaml, testing::scheduling_registry());
+  if (s) s->run_for(for_ns);
+  return s;
 }
 
 // "a@0 b@2 ...": each job start as task@time in ms.
@@ -41,12 +33,7 @@ std::string starts() {
   return out;
 }
 
-TaskStatsSnapshot stats_of(Subsystem& s, const std::string& task) {
-  for (const auto& t : s.snapshot())
-    if (t.name == task) return t.stats;
-  ADD_FAILURE() << "no task " << task;
-  return {};
-}
+TaskStatsSnapshot stats_of(Subsystem& s, const std::string& task) { return testing::task_of(s, task).stats; }
 
 // Two tasks on one CPU, U = 2/5 + 4/7 = 0.97: feasible under EDF, not under RM (Buttazzo,
 // Hard Real-Time Computing Systems, 3rd ed., figure 4.11's kind of set).

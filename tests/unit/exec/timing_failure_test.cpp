@@ -8,6 +8,7 @@
 
 #include "chimera/config/loader.hpp"
 #include "chimera/exec/subsystem.hpp"
+#include "support/run_subsystem.hpp"
 #include "support/trace_module.hpp"
 
 namespace chimera {
@@ -16,27 +17,12 @@ namespace {
 constexpr std::int64_t kMs = 1'000'000;
 
 std::unique_ptr<Subsystem> run(const std::string& tasks, std::int64_t for_ns) {
-  auto spec =
-      load_subsystem_text("subsystem: timing\ncpus: [0]\ntasks:\n" + tasks, "t.yaml", testing::scheduling_registry());
-  EXPECT_TRUE(spec.ok()) << (spec.ok() ? "" : spec.error().message);
-  if (!spec.ok()) return nullptr;
-  RunOptions o;
-  o.clock = ClockKind::kVirtual;
-  o.shm_suffix = testing::unique_suffix();
-  auto s = Subsystem::create(*spec, testing::scheduling_registry(), o);
-  EXPECT_TRUE(s.ok()) << (s.ok() ? "" : s.error().message);
-  if (!s.ok()) return nullptr;
-  EXPECT_TRUE((*s)->start().ok());
-  (*s)->run_for(for_ns);
-  return std::move(*s);
+  auto s = testing::start_subsystem("subsystem: timing\ncpus: [0]\ntasks:\n" + tasks, testing::scheduling_registry());
+  if (s) s->run_for(for_ns);
+  return s;
 }
 
-TaskSnapshot task(Subsystem& s, const std::string& name) {
-  for (const auto& t : s.snapshot())
-    if (t.name == name) return t;
-  ADD_FAILURE() << "no task " << name;
-  return {};
-}
+TaskSnapshot task(Subsystem& s, const std::string& name) { return testing::task_of(s, name); }
 
 std::string events_text(Subsystem& s) {
   std::string out;

@@ -9,6 +9,7 @@
 #include "chimera/config/loader.hpp"
 #include "chimera/exec/subsystem.hpp"
 #include "support/reconfig_modules.hpp"
+#include "support/run_subsystem.hpp"
 
 namespace chimera {
 namespace {
@@ -16,25 +17,10 @@ namespace {
 constexpr std::int64_t kMs = 1'000'000;
 
 std::unique_ptr<Subsystem> start(const std::string& yaml) {
-  auto spec = load_subsystem_text(yaml, "real_switch.yaml", testing::reconfig_registry());
-  EXPECT_TRUE(spec.ok()) << (spec.ok() ? "" : spec.error().message);
-  if (!spec.ok()) return nullptr;
-  RunOptions o;
-  o.clock = ClockKind::kReal;
-  o.shm_suffix = testing::unique_suffix();
-  o.realtime_priorities = false;  // ordinary threads: the behaviour must not depend on SCHED_FIFO
-  auto s = Subsystem::create(*spec, testing::reconfig_registry(), o);
-  EXPECT_TRUE(s.ok()) << (s.ok() ? "" : s.error().message);
-  if (!s.ok()) return nullptr;
-  EXPECT_TRUE((*s)->start().ok());
-  return std::move(*s);
+  return testing::start_subsystem(yaml, testing::reconfig_registry(), ClockKind::kReal);
 }
 
-TaskStatsSnapshot stats_of(Subsystem& s, const std::string& name) {
-  for (const auto& t : s.snapshot())
-    if (t.name == name) return t.stats;
-  return {};
-}
+TaskStatsSnapshot stats_of(Subsystem& s, const std::string& name) { return testing::task_of(s, name).stats; }
 
 // Soft tasks: a cycle late on a loaded machine must not end the test in ERROR.
 const std::string kTwoProducers = R"(subsystem: rsw

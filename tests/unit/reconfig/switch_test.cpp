@@ -9,6 +9,7 @@
 #include "chimera/config/loader.hpp"
 #include "chimera/exec/subsystem.hpp"
 #include "support/reconfig_modules.hpp"
+#include "support/run_subsystem.hpp"
 
 namespace chimera {
 namespace {
@@ -16,27 +17,12 @@ namespace {
 constexpr std::int64_t kMs = 1'000'000;
 
 std::unique_ptr<Subsystem> start(const std::string& yaml) {
-  auto spec = load_subsystem_text(yaml, "switch.yaml", testing::reconfig_registry());
-  EXPECT_TRUE(spec.ok()) << (spec.ok() ? "" : spec.error().message);
-  if (!spec.ok()) return nullptr;
-  RunOptions o;
-  o.clock = ClockKind::kVirtual;
-  o.shm_suffix = testing::unique_suffix();
-  auto s = Subsystem::create(*spec, testing::reconfig_registry(), o);
-  EXPECT_TRUE(s.ok()) << (s.ok() ? "" : s.error().message);
-  if (!s.ok()) return nullptr;
-  EXPECT_TRUE((*s)->start().ok());
-  return std::move(*s);
+  return testing::start_subsystem(yaml, testing::reconfig_registry());
 }
 
 double value(Subsystem& s, const std::string& var) { return s.get(var)->at(0); }
 
-TaskSnapshot task(Subsystem& s, const std::string& name) {
-  for (const auto& t : s.snapshot())
-    if (t.name == name) return t;
-  ADD_FAILURE() << "no task " << name;
-  return {};
-}
+TaskSnapshot task(Subsystem& s, const std::string& name) { return testing::task_of(s, name); }
 
 // Two producers of one variable, one consumer that stays (the robot interface's place), and a
 // watcher of the flag.
