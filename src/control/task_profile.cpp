@@ -28,10 +28,8 @@ std::string histogram(std::string_view title, const Buckets& buckets) {
   std::vector<std::int64_t> upper(rows, 0);
   for (const auto& [bound, count] : buckets) {
     const double x = std::log(static_cast<double>(std::max<std::int64_t>(1, bound)));
-    const auto row =
-        rows == 1
-            ? 0
-            : std::min(rows - 1, static_cast<std::size_t>((x - lo) / (hi - lo) * static_cast<double>(rows - 1) + 0.5));
+    const double position = rows == 1 ? 0.0 : (x - lo) / (hi - lo) * static_cast<double>(rows - 1);
+    const auto row = std::min(rows - 1, static_cast<std::size_t>(std::lround(position)));
     counts[row] += count;
     upper[row] = std::max(upper[row], bound);
   }

@@ -9,7 +9,7 @@
 namespace chimera {
 
 PriorityDispatcher::PriorityDispatcher(int cpu, SchedulerKind policy, std::vector<Worker*> workers,
-                                       std::vector<TaskUrgency> urgency)
+                                       const std::vector<TaskUrgency>& urgency)
     : cpu_(cpu),
       policy_(policy),
       workers_(std::move(workers)),

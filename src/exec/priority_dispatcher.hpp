@@ -25,7 +25,8 @@ class PriorityDispatcher {
   static constexpr int kTopJobPriority = 88;     // the most urgent job; then one less each
   static constexpr int kLowestJobPriority = 2;   // 1 is background work
 
-  PriorityDispatcher(int cpu, SchedulerKind policy, std::vector<Worker*> workers, std::vector<TaskUrgency> urgency);
+  PriorityDispatcher(int cpu, SchedulerKind policy, std::vector<Worker*> workers,
+                     const std::vector<TaskUrgency>& urgency);
   ~PriorityDispatcher();
   PriorityDispatcher(const PriorityDispatcher&) = delete;
   PriorityDispatcher& operator=(const PriorityDispatcher&) = delete;

@@ -82,6 +82,13 @@ void prepare_realtime_process(bool realtime) {
 RealExecutive::RealExecutive(const std::vector<Task*>& tasks, const ReleaseOrder& order, const SchedulePlan& plan,
                              bool realtime, const GlobalTable& table)
     : table_(table), epoch_ns_(monotonic_ns()), realtime_(realtime) {
+  make_workers(tasks, plan);
+  link_workers(order);
+  if (!is_fixed_priority(plan.policy)) make_dispatchers(plan);
+  form_threads(order);
+}
+
+void RealExecutive::make_workers(const std::vector<Task*>& tasks, const SchedulePlan& plan) {
   const std::vector<int> priorities = fixed_priorities(plan);
   for (std::size_t i = 0; i < tasks.size(); ++i) {
     auto w = std::make_unique<Worker>();
@@ -98,40 +105,41 @@ RealExecutive::RealExecutive(const std::vector<Task*>& tasks, const ReleaseOrder
     }
     for (const auto& b : tasks[i]->resolved().bindings)
       if (b.kind == PortKind::kOutVar)
-        if (auto v = table.find(b.variable)) w->out_vars.push_back(static_cast<int>(*v));
+        if (auto v = table_.find(b.variable)) w->out_vars.push_back(static_cast<int>(*v));
     workers_.push_back(std::move(w));
   }
+}
+
+void RealExecutive::link_workers(const ReleaseOrder& order) {
+  // Whether aperiodic task `j` reads one of task `i`'s outputs: then `i` may trigger it.
+  const auto reads_from = [&](const Worker& j, const Worker& i) {
+    return std::ranges::any_of(j.task->resolved().bindings, [&](const PortBinding& b) {
+      const auto v = b.kind == PortKind::kInVar ? table_.find(b.variable) : std::nullopt;
+      return v && std::ranges::find(i.out_vars, static_cast<int>(*v)) != i.out_vars.end();
+    });
+  };
   for (std::size_t i = 0; i < workers_.size(); ++i) {
     for (const int p : order.predecessors[i])
       workers_[i]->predecessors.push_back(workers_[static_cast<std::size_t>(p)].get());
-    // Aperiodic tasks that read one of this task's outputs may be triggered by it.
-    for (std::size_t j = 0; j < workers_.size(); ++j) {
-      if (j == i || tasks[j]->periodic()) continue;
-      const auto& reads = tasks[j]->resolved().bindings;
-      const bool shares = std::any_of(reads.begin(), reads.end(), [&](const PortBinding& b) {
-        if (b.kind != PortKind::kInVar) return false;
-        const auto v = table.find(b.variable);
-        return v && std::find(workers_[i]->out_vars.begin(), workers_[i]->out_vars.end(), static_cast<int>(*v)) !=
-                        workers_[i]->out_vars.end();
-      });
-      if (shares) workers_[i]->subscribers.push_back(workers_[j].get());
-    }
+    for (std::size_t j = 0; j < workers_.size(); ++j)
+      if (j != i && !workers_[j]->task->periodic() && reads_from(*workers_[j], *workers_[i]))
+        workers_[i]->subscribers.push_back(workers_[j].get());
   }
-  if (!is_fixed_priority(plan.policy)) {
-    std::map<int, std::pair<std::vector<Worker*>, std::vector<TaskUrgency>>> per_cpu;
-    for (std::size_t i = 0; i < workers_.size(); ++i) {
-      if (plan.urgency[i].background) continue;
-      per_cpu[plan.cpu[i]].first.push_back(workers_[i].get());
-      per_cpu[plan.cpu[i]].second.push_back(plan.urgency[i]);
-    }
-    for (auto& [cpu, group] : per_cpu) {
-      auto d = std::make_unique<PriorityDispatcher>(cpu, plan.policy, group.first, group.second);
-      for (Worker* w : group.first) w->dispatcher = d.get();
-      d->start(realtime_);
-      dispatchers_.push_back(std::move(d));
-    }
+}
+
+void RealExecutive::make_dispatchers(const SchedulePlan& plan) {
+  std::map<int, std::pair<std::vector<Worker*>, std::vector<TaskUrgency>>> per_cpu;
+  for (std::size_t i = 0; i < workers_.size(); ++i) {
+    if (plan.urgency[i].background) continue;
+    per_cpu[plan.cpu[i]].first.push_back(workers_[i].get());
+    per_cpu[plan.cpu[i]].second.push_back(plan.urgency[i]);
   }
-  form_threads(order);
+  for (auto& [cpu, group] : per_cpu) {
+    auto d = std::make_unique<PriorityDispatcher>(cpu, plan.policy, group.first, group.second);
+    for (Worker* w : group.first) w->dispatcher = d.get();
+    d->start(realtime_);
+    dispatchers_.push_back(std::move(d));
+  }
 }
 
 void RealExecutive::form_threads(const ReleaseOrder& order) {
@@ -180,7 +188,8 @@ void* thread_entry(void* arg) {
 }
 }  // namespace
 
-Result<void> RealExecutive::start_thread(TaskThread& w) {
+Result<void> RealExecutive::start_thread(TaskThread& thread) const {
+  TaskThread& w = thread;
   w.exiting.store(false, std::memory_order_relaxed);  // a new thread; the old one was joined
   w.alive = 0;                                        // written before the thread exists
   pthread_attr_t attr;

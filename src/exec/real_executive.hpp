@@ -63,15 +63,18 @@ class RealExecutive {
   [[nodiscard]] int fixed_priority(std::size_t index) const;
 
  private:
-  Result<void> start_thread(TaskThread& thread);
+  void make_workers(const std::vector<Task*>& tasks, const SchedulePlan& plan);
+  void link_workers(const ReleaseOrder& order);
+  void make_dispatchers(const SchedulePlan& plan);
   void form_threads(const ReleaseOrder& order);
+  Result<void> start_thread(TaskThread& thread) const;
   /// Posts `mail` to a task's thread and waits for its answer. Not real-time safe.
-  Result<void> post(Worker& w, Mail mail);
+  static Result<void> post(Worker& w, Mail mail);
   /// Posts `mail` to several tasks' threads at once, then waits for every answer.
   Result<void> post_all(const std::vector<std::size_t>& indices, const std::vector<Mail>& mails);
   /// Posts only; returns the sequence number of the answer to wait for.
-  std::uint32_t send(Worker& w, const Mail& mail);
-  Result<void> await(Worker& w, std::uint32_t seq);
+  static std::uint32_t send(Worker& w, const Mail& mail);
+  static Result<void> await(Worker& w, std::uint32_t seq);
   Result<void> turn_on_locked(const std::vector<std::size_t>& indices, std::int64_t not_before_ns);
 
   std::vector<std::unique_ptr<PriorityDispatcher>> dispatchers_;  // outlive the workers that poke them

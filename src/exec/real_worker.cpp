@@ -36,7 +36,7 @@ Worker::~Worker() {
 void ring_bell(const Worker& w) noexcept {
   if (w.bell_fd < 0) return;
   const std::uint64_t one = 1;
-  (void)!::write(w.bell_fd, &one, sizeof(one));  // an eventfd counter: a full one still wakes
+  [[maybe_unused]] const ssize_t put = ::write(w.bell_fd, &one, sizeof(one));  // a full counter still wakes
 }
 
 bool Worker::take_mail() {
@@ -254,7 +254,7 @@ void Worker::run_aperiodic() {
     (void)::ppoll(fds.data(), n, timeout, nullptr);
     if ((fds[0].revents & POLLIN) != 0) {
       std::uint64_t drained = 0;
-      (void)!::read(bell_fd, &drained, sizeof(drained));
+      [[maybe_unused]] const ssize_t got = ::read(bell_fd, &drained, sizeof(drained));  // only drains the counter
     }
   }
   if (request_seq.load(std::memory_order_acquire) != req) return;  // the mail first; acquire: as in main

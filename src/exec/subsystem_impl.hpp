@@ -59,6 +59,20 @@ struct Subsystem::Impl {
   std::thread request_service;  // real clock: carries out the switches tasks ask for
   std::atomic<bool> service_stop{false};
 
+  // The steps of a switch (reconfig/switch.cpp).
+  /// Creates `to_spawn` in the background, publishing nothing; kills them again if one fails.
+  Result<void> create_for_switch(const std::vector<std::size_t>& to_spawn);
+  /// The commit: `leaving` off and `joining` on at one cycle boundary (after a cycle of the old
+  /// configuration on the virtual clock when the switch `created` tasks). Plans `target` anew.
+  Result<void> commit_switch(const std::vector<std::size_t>& leaving, const std::vector<std::size_t>& joining,
+                             bool created, const std::vector<std::string>& target);
+  /// reinit() on every ON task outside `joining` that reads a constant of `changed`; their names.
+  std::vector<std::string> reinit_readers(const std::vector<std::string>& changed,
+                                          const std::vector<std::size_t>& joining);
+  /// The smallest period among the periodic tasks `indices` (0: none).
+  [[nodiscard]] std::int64_t shortest_period(const std::vector<std::size_t>& a,
+                                             const std::vector<std::size_t>& b) const;
+
   /// The illegal-configuration flag: up while a switch creates tasks, or while a task is in ERROR.
   void update_flag() {
     bool error = false;

@@ -1,5 +1,6 @@
 #include "chimera/exec/task.hpp"
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <charconv>
@@ -27,7 +28,12 @@ Task::Task(const ResolvedTask& resolved, GlobalTable& table, const SubsystemFlag
 }
 
 Task::~Task() {
-  if (state() != TaskState::kNotCreated) (void)apply(Signal::kKill, timing_.release_ns);
+  // A destructor must not throw: the kill's message (a std::string) could fail to allocate.
+  try {
+    if (state() != TaskState::kNotCreated) (void)apply(Signal::kKill, timing_.release_ns);
+  } catch (...) {
+    destroy_module();
+  }
 }
 
 Status Task::call_raw(Hook hook) noexcept {
@@ -125,9 +131,8 @@ std::int64_t Task::end_job(std::int64_t end_ns, std::int64_t used_ns) noexcept {
 }
 
 bool Task::reads_const(std::string_view name) const {
-  for (const auto& b : resolved_.bindings)
-    if (b.kind == PortKind::kInConst && b.variable == name) return true;
-  return false;
+  return std::ranges::any_of(resolved_.bindings,
+                             [&](const PortBinding& b) { return b.kind == PortKind::kInConst && b.variable == name; });
 }
 
 std::vector<std::string> Task::const_outputs() const {

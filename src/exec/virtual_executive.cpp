@@ -35,13 +35,12 @@ bool VirtualExecutive::blocked_by_producer(std::size_t i) const {
   // release, as the real executive's precedence wait does, and no longer than that wait's bound.
   const Slot& s = slots_[i];
   if (now_ns_ >= s.job.wait_until_ns) return false;
-  for (const int p : order_.predecessors[i]) {
+  return std::ranges::any_of(order_.predecessors[i], [&](int p) {
     const Slot& ps = slots_[static_cast<std::size_t>(p)];
-    if (tasks_[static_cast<std::size_t>(p)]->state() != TaskState::kOn) continue;
-    if (ps.first_release_ns > s.job.release_ns) continue;  // it joined after this release
-    if (ps.last_done_release_ns < s.job.release_ns) return true;
-  }
-  return false;
+    if (tasks_[static_cast<std::size_t>(p)]->state() != TaskState::kOn) return false;
+    if (ps.first_release_ns > s.job.release_ns) return false;  // it joined after this release
+    return ps.last_done_release_ns < s.job.release_ns;
+  });
 }
 
 bool VirtualExecutive::ready(std::size_t i) const {

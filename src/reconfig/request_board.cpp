@@ -5,7 +5,7 @@
 namespace chimera {
 
 SubsystemRequestBoard::SubsystemRequestBoard(std::vector<std::string> configurations, std::size_t tasks)
-    : configurations_(std::move(configurations)), slots_(std::make_unique<std::atomic<int>[]>(tasks)), tasks_(tasks) {
+    : configurations_(std::move(configurations)), slots_(tasks) {
   clear();
 }
 
@@ -16,7 +16,7 @@ int SubsystemRequestBoard::configuration_index(std::string_view name) const {
 }
 
 void SubsystemRequestBoard::post(int task, int configuration) noexcept {
-  if (task < 0 || static_cast<std::size_t>(task) >= tasks_) return;
+  if (task < 0 || static_cast<std::size_t>(task) >= slots_.size()) return;
   // acq_rel: what the task did before asking is seen by whoever serves the request. Asking again
   // for the same thing costs one exchange and no system call.
   if (slots_[static_cast<std::size_t>(task)].exchange(configuration, std::memory_order_acq_rel) == configuration)
@@ -30,8 +30,7 @@ int SubsystemRequestBoard::asked(std::size_t task) const noexcept {
 }
 
 void SubsystemRequestBoard::clear() noexcept {
-  for (std::size_t i = 0; i < tasks_; ++i)
-    slots_[i].store(-1, std::memory_order_relaxed);  // only hints until the next post
+  for (auto& slot : slots_) slot.store(-1, std::memory_order_relaxed);  // only hints until the next post
 }
 
 void SubsystemRequestBoard::wake() noexcept {

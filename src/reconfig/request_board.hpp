@@ -36,8 +36,7 @@ class SubsystemRequestBoard final : public RequestBoard {
 
  private:
   std::vector<std::string> configurations_;
-  std::unique_ptr<std::atomic<int>[]> slots_;  // per task: the configuration asked for, -1: none
-  std::size_t tasks_;
+  std::vector<std::atomic<int>> slots_;  // per task: the configuration asked for, -1: none
   alignas(64) std::atomic<std::uint32_t> changes_{0};
 };
 

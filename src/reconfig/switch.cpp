@@ -75,6 +75,91 @@ std::vector<SwitchRecord> Subsystem::switches() const {
   return impl_->history;
 }
 
+namespace {
+
+// The names of the variables the out-consts of `indices` are bound to.
+std::vector<std::string> const_outputs_of(const std::vector<std::unique_ptr<Task>>& tasks,
+                                          const std::vector<std::size_t>& indices) {
+  std::vector<std::string> out;
+  for (const std::size_t i : indices)
+    for (auto& c : tasks[i]->const_outputs()) out.push_back(std::move(c));
+  return out;
+}
+
+std::vector<std::string> changed_values(const std::map<std::string, std::vector<double>>& before,
+                                        const std::map<std::string, std::vector<double>>& after) {
+  std::vector<std::string> changed;
+  for (const auto& [var, value] : after) {
+    const auto old = before.find(var);
+    if (old == before.end() || old->second != value) changed.push_back(var);
+  }
+  return changed;
+}
+
+}  // namespace
+
+std::int64_t Subsystem::Impl::shortest_period(const std::vector<std::size_t>& a,
+                                              const std::vector<std::size_t>& b) const {
+  std::int64_t shortest = 0;
+  for (const auto* list : {&a, &b})
+    for (const std::size_t i : *list)
+      if (tasks[i]->periodic() && (shortest == 0 || tasks[i]->period_ns() < shortest)) shortest = tasks[i]->period_ns();
+  return shortest;
+}
+
+Result<void> Subsystem::Impl::create_for_switch(const std::vector<std::size_t>& to_spawn) {
+  std::vector<std::size_t> created;
+  for (const std::size_t i : to_spawn) {
+    tasks[i]->set_publish_at_spawn(false);  // the current configuration's producers are still ON
+    auto r = signal(i, Signal::kSpawn);
+    tasks[i]->set_publish_at_spawn(true);
+    if (!r) {
+      for (auto it = created.rbegin(); it != created.rend(); ++it) (void)signal(*it, Signal::kKill);
+      return r;
+    }
+    created.push_back(i);
+  }
+  return {};
+}
+
+Result<void> Subsystem::Impl::commit_switch(const std::vector<std::size_t>& leaving,
+                                            const std::vector<std::size_t>& joining, bool created,
+                                            const std::vector<std::string>& target) {
+  const std::int64_t shortest = shortest_period(leaving, joining);
+  plan = make_schedule_plan(resolution.subsystem, order, subsystem_cpus(spec), target);
+  if (real_exec) {
+    const std::int64_t now = real_exec->now_ns();
+    const std::int64_t at = shortest > 0 ? ((now + kCommitMarginNs) / shortest + 1) * shortest : now;
+    auto committed = real_exec->commit_switch(leaving, joining, at);
+    real_exec->set_plan(plan);
+    return committed;
+  }
+  // Creating tasks takes no simulated time, but a switch that must create them is one that takes
+  // longer than a cycle: the old configuration runs on, flag raised, until the next boundary of
+  // the fastest task involved.
+  if (created && shortest > 0) (void)virtual_exec->run_until((virtual_exec->now_ns() / shortest + 1) * shortest);
+  Result<void> committed;
+  for (const std::size_t i : leaving) (void)signal(i, Signal::kOff);
+  for (const std::size_t i : joining)
+    if (auto r = signal(i, Signal::kOn); !r && committed) committed = r;
+  virtual_exec->set_plan(plan);
+  return committed;
+}
+
+std::vector<std::string> Subsystem::Impl::reinit_readers(const std::vector<std::string>& changed,
+                                                         const std::vector<std::size_t>& joining) {
+  std::vector<std::string> names;
+  for (std::size_t i = 0; i < tasks.size(); ++i) {
+    const Task& t = *tasks[i];
+    if (t.state() != TaskState::kOn) continue;
+    if (std::find(joining.begin(), joining.end(), i) != joining.end()) continue;  // it read them at on()
+    if (std::none_of(changed.begin(), changed.end(), [&](const std::string& v) { return t.reads_const(v); })) continue;
+    names.push_back(t.name());
+    (void)(virtual_exec ? virtual_exec->reinit(i) : real_exec->reinit(i));
+  }
+  return names;
+}
+
 Result<SwitchRecord> Subsystem::switch_locked(std::string_view name, std::string_view cause,
                                               std::int64_t requested_ns) {
   Impl& m = *impl_;
@@ -95,95 +180,40 @@ Result<SwitchRecord> Subsystem::switch_locked(std::string_view name, std::string
   if (!plan)
     return make_error(plan.error().code, fmt::format("switch to '{}' refused: {}", name, plan.error().message));
 
-  SwitchRecord record;
-  record.from = m.configuration;
-  record.to = target->name;
-  record.cause = std::string(cause);
-  record.requested_ns = requested_ns;
-  record.off = names_of(m.tasks, plan->leaving);
-  record.on = names_of(m.tasks, plan->joining);
-  record.spawned = names_of(m.tasks, plan->to_spawn);
-  record.flag_raised = !plan->to_spawn.empty();
-
-  // The in-consts that may change value: the out-consts of the tasks leaving and joining.
-  std::vector<std::string> consts;
-  for (const std::size_t i : plan->leaving)
-    for (auto& c : m.tasks[i]->const_outputs()) consts.push_back(std::move(c));
-  for (const std::size_t i : plan->joining)
-    for (auto& c : m.tasks[i]->const_outputs()) consts.push_back(std::move(c));
-  // Read before any task is created: a new producer publishes its out-consts at init.
+  SwitchRecord record{m.configuration,
+                      target->name,
+                      std::string(cause),
+                      requested_ns,
+                      0,
+                      names_of(m.tasks, plan->leaving),
+                      names_of(m.tasks, plan->joining),
+                      names_of(m.tasks, plan->to_spawn),
+                      {},
+                      !plan->to_spawn.empty()};
+  // The in-consts that may change value: the out-consts of the tasks leaving and joining, read
+  // before any task is created (a new producer publishes its out-consts at on()).
+  std::vector<std::string> consts = const_outputs_of(m.tasks, plan->leaving);
+  for (auto& c : const_outputs_of(m.tasks, plan->joining)) consts.push_back(std::move(c));
   const auto before = read_values(*m.table, consts);
 
   // A switch that must create tasks takes longer than a cycle: the flag tells every module so,
   // and critical ones (the robot interfaces) hold still until it is lowered.
   m.switching_flag = record.flag_raised;
   m.update_flag();
-  std::vector<std::size_t> created;
-  for (const std::size_t i : plan->to_spawn) {
-    m.tasks[i]->set_publish_at_spawn(false);  // the current configuration's producers are still ON
-    auto r = m.signal(i, Signal::kSpawn);
-    m.tasks[i]->set_publish_at_spawn(true);
-    if (!r) {
-      for (auto it = created.rbegin(); it != created.rend(); ++it) (void)m.signal(*it, Signal::kKill);
-      m.switching_flag = false;
-      m.update_flag();
-      m.collect_events();
-      return make_error(r.error().code,
-                        fmt::format("switch to '{}' refused: {}; nothing changed", name, r.error().message));
-    }
-    created.push_back(i);
+  if (auto created = m.create_for_switch(plan->to_spawn); !created) {
+    m.switching_flag = false;
+    m.update_flag();
+    m.collect_events();
+    return make_error(created.error().code,
+                      fmt::format("switch to '{}' refused: {}; nothing changed", name, created.error().message));
   }
 
-  // Phase 2, commit at one cycle boundary.
-  std::int64_t shortest = 0;
-  for (const std::size_t i : plan->leaving)
-    if (m.tasks[i]->periodic())
-      shortest = shortest == 0 ? m.tasks[i]->period_ns() : std::min(shortest, m.tasks[i]->period_ns());
-  for (const std::size_t i : plan->joining)
-    if (m.tasks[i]->periodic())
-      shortest = shortest == 0 ? m.tasks[i]->period_ns() : std::min(shortest, m.tasks[i]->period_ns());
-  const ConfigurationSpec* from_config = m.spec.find_configuration(m.configuration);
-  m.plan = make_schedule_plan(m.resolution.subsystem, m.order, subsystem_cpus(m.spec), target->tasks);
-  Result<void> committed;
-  if (m.virtual_exec) {
-    // Creating tasks takes no simulated time, but a switch that must create them is one that
-    // takes longer than a cycle: the old configuration runs on, flag raised, until the next
-    // boundary of the fastest task involved.
-    if (record.flag_raised && shortest > 0) {
-      const std::int64_t now = m.virtual_exec->now_ns();
-      (void)m.virtual_exec->run_until((now / shortest + 1) * shortest);
-    }
-    for (const std::size_t i : plan->leaving) (void)m.signal(i, Signal::kOff);
-    for (const std::size_t i : plan->joining)
-      if (auto r = m.signal(i, Signal::kOn); !r && committed) committed = r;
-    m.virtual_exec->set_plan(m.plan);
-  } else {
-    const std::int64_t now = m.real_exec->now_ns();
-    const std::int64_t at = shortest > 0 ? ((now + kCommitMarginNs) / shortest + 1) * shortest : now;
-    committed = m.real_exec->commit_switch(plan->leaving, plan->joining, at);
-    m.real_exec->set_plan(m.plan);
-  }
+  // Phase 2, commit at one cycle boundary; then consumers of a constant whose value changed read
+  // it anew before their next cycle.
+  const Result<void> committed = m.commit_switch(plan->leaving, plan->joining, record.flag_raised, target->tasks);
   record.committed_ns = m.now();
   m.configuration = target->name;
-  (void)from_config;
-
-  // Consumers of a constant whose value changed read it anew before their next cycle.
-  const auto after = read_values(*m.table, consts);
-  std::vector<std::string> changed;
-  for (const auto& [var, value] : after) {
-    const auto old = before.find(var);
-    if (old == before.end() || old->second != value) changed.push_back(var);
-  }
-  for (std::size_t i = 0; i < m.tasks.size(); ++i) {
-    Task& t = *m.tasks[i];
-    if (t.state() != TaskState::kOn) continue;
-    if (std::find(plan->joining.begin(), plan->joining.end(), i) != plan->joining.end()) continue;  // read at on()
-    const bool reads =
-        std::any_of(changed.begin(), changed.end(), [&](const std::string& v) { return t.reads_const(v); });
-    if (!reads) continue;
-    record.reinit.push_back(t.name());
-    (void)(m.virtual_exec ? m.virtual_exec->reinit(i) : m.real_exec->reinit(i));
-  }
+  record.reinit = m.reinit_readers(changed_values(before, read_values(*m.table, consts)), plan->joining);
 
   m.switching_flag = false;
   m.update_flag();

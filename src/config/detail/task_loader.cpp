@@ -65,53 +65,66 @@ Result<void> read_criticality(const Source& source, const MapReader& map, TaskSp
 }
 
 // priority, late, virtual_exec and server: how the executive treats the task (docs/scheduling.md).
-Result<void> read_scheduling(const Source& source, const MapReader& map, TaskSpec& task) {
-  if (const auto f = map.get("priority")) {
-    auto n = read_number(source, *f);
-    if (!n) return n.error();
-    if (*n != static_cast<double>(static_cast<int>(*n)) || *n < -kMaxUserPriority || *n > kMaxUserPriority)
-      return source.fail(*f, fmt::format("{} is not a whole number from -{} to {}", describe(f->node), kMaxUserPriority,
-                                         kMaxUserPriority));
-    task.priority = static_cast<int>(*n);
-  }
+Result<void> read_priority(const Source& source, const MapReader& map, TaskSpec& task) {
+  const auto f = map.get("priority");
+  if (!f) return {};
+  auto n = read_number(source, *f);
+  if (!n) return n.error();
+  if (*n != static_cast<double>(static_cast<int>(*n)) || *n < -kMaxUserPriority || *n > kMaxUserPriority)
+    return source.fail(*f, fmt::format("{} is not a whole number from -{} to {}", describe(f->node), kMaxUserPriority,
+                                       kMaxUserPriority));
+  task.priority = static_cast<int>(*n);
+  return {};
+}
+
+Result<void> read_late(const Source& source, const MapReader& map, TaskSpec& task) {
   task.late = task.criticality == Criticality::kSoft ? LatePolicy::kSkip : LatePolicy::kRun;
-  if (const auto f = map.get("late")) {
-    const std::string text = f->node.IsScalar() ? f->node.Scalar() : std::string();
-    if (text == "run") {
-      task.late = LatePolicy::kRun;
-    } else if (text == "skip") {
-      task.late = LatePolicy::kSkip;
-    } else {
-      return source.fail(*f, fmt::format("{} is not a late-cycle policy (use run or skip)", describe(f->node)));
-    }
-    if (!task.period_ns) return source.fail(*f, "only a periodic task has releases to run late or skip");
+  const auto f = map.get("late");
+  if (!f) return {};
+  const std::string text = f->node.IsScalar() ? f->node.Scalar() : std::string();
+  if (text == "run") {
+    task.late = LatePolicy::kRun;
+  } else if (text == "skip") {
+    task.late = LatePolicy::kSkip;
+  } else {
+    return source.fail(*f, fmt::format("{} is not a late-cycle policy (use run or skip)", describe(f->node)));
   }
+  if (!task.period_ns) return source.fail(*f, "only a periodic task has releases to run late or skip");
+  return {};
+}
+
+Result<void> read_server(const Source& source, const MapReader& map, TaskSpec& task) {
+  const auto f = map.get("server");
+  if (!f) return {};
+  if (task.period_ns)
+    return source.fail(*f, "a server is for an aperiodic task (this one has a period; remove one of them)");
+  auto server = MapReader::create(source, *f, "a server", {"budget", "period"});
+  if (!server) return server.error();
+  ServerSpec spec;
+  for (auto [key, out] : {std::pair{"budget", &spec.budget_ns}, std::pair{"period", &spec.period_ns}}) {
+    auto field = server->require(source, key, "a server has a budget and a period, e.g. { budget: 1ms, period: 10ms }");
+    if (!field) return field.error();
+    auto ns = read_duration(source, *field);
+    if (!ns) return ns.error();
+    if (*ns <= 0) return source.fail(*field, "must be greater than zero");
+    *out = *ns;
+  }
+  if (spec.budget_ns > spec.period_ns)
+    return source.fail(*server->get("budget"), "the budget cannot be longer than the server's period");
+  task.server = spec;
+  if (!map.get("deadline")) task.deadline_ns = spec.period_ns;  // an event is served within a period
+  return {};
+}
+
+Result<void> read_scheduling(const Source& source, const MapReader& map, TaskSpec& task) {
+  if (auto ok = read_priority(source, map, task); !ok) return ok;
+  if (auto ok = read_late(source, map, task); !ok) return ok;
   if (const auto f = map.get("virtual_exec")) {
     auto ns = read_duration(source, *f);
     if (!ns) return ns.error();
     task.virtual_exec_ns = *ns;
   }
-  if (const auto f = map.get("server")) {
-    if (task.period_ns)
-      return source.fail(*f, "a server is for an aperiodic task (this one has a period; remove one of them)");
-    auto server = MapReader::create(source, *f, "a server", {"budget", "period"});
-    if (!server) return server.error();
-    ServerSpec spec;
-    for (auto [key, out] : {std::pair{"budget", &spec.budget_ns}, std::pair{"period", &spec.period_ns}}) {
-      auto field =
-          server->require(source, key, "a server has a budget and a period, e.g. { budget: 1ms, period: 10ms }");
-      if (!field) return field.error();
-      auto ns = read_duration(source, *field);
-      if (!ns) return ns.error();
-      if (*ns <= 0) return source.fail(*field, "must be greater than zero");
-      *out = *ns;
-    }
-    if (spec.budget_ns > spec.period_ns)
-      return source.fail(*server->get("budget"), "the budget cannot be longer than the server's period");
-    task.server = spec;
-    if (!map.get("deadline")) task.deadline_ns = spec.period_ns;  // an event is served within a period
-  }
-  return {};
+  return read_server(source, map, task);
 }
 
 Result<void> read_cpu(const Source& source, const MapReader& map, const std::vector<int>& cpus, TaskSpec& task) {
