@@ -4,12 +4,15 @@
 //
 //   switch_bench [--quick] [--out FILE] [--samples-dir DIR] [--switches N]
 //
-// Keys: switch_lost_cycles (the staying task's releases that did not run, plus its cycles that
-// did not get the value of their own release from whichever producer was on), and
-// switch_commit_latency_ns_p50 / _p99 (from the request to the commit at a cycle boundary).
+// Keys: switch_lost_cycles (the staying task's releases that did not run, plus the releases that
+// no producer, or two, ran: the staying task's cycles against the producers' together), and
+// switch_commit_latency_ns_p50 / _p99 (from the request to the commit at a cycle boundary). The
+// staying task's cycles that did not read the value of their own release are counted beside it,
+// with a control run of as long without a switch: the machine's stalls cause those too.
 
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -63,12 +66,36 @@ configurations:
     return 1;
   }
   s.run_for(50'000'000);
-  auto robot_of = [&] {
+  auto stats_of = [&](const char* name) {
     for (const auto& t : s.snapshot())
-      if (t.name == "robot") return t.stats;
+      if (t.name == name) return t.stats;
     return TaskStatsSnapshot{};
   };
+  auto robot_of = [&] { return stats_of("robot"); };
+  auto produced = [&] { return stats_of("a").cycles + stats_of("b").cycles; };
+  // The control: as long again without switching, half of it under each producer (they may run
+  // on different CPUs from the staying task, which then waits for them across CPUs). What the
+  // machine's stalls cost the staying task there is not the switches' doing.
+  const std::int64_t idle_ns = static_cast<std::int64_t>(switches) * 1'000'000;
+  TaskStatsSnapshot idle_before = robot_of();
+  double idle_stale_before = s.get("stale")->at(0);
+  std::uint64_t idle_timeouts = 0;
+  std::uint64_t idle_missed = 0;
+  double idle_stale = 0;
+  for (const char* config : {"with_b", "with_a"}) {
+    s.run_for(idle_ns / 2);
+    const TaskStatsSnapshot now = robot_of();
+    idle_timeouts += now.order_timeouts - idle_before.order_timeouts;
+    idle_missed += now.missed - idle_before.missed;
+    idle_stale += s.get("stale")->at(0) - idle_stale_before;
+    (void)s.switch_to(config);  // not counted: the measured switches come below
+    s.run_for(10'000'000);
+    idle_before = robot_of();
+    idle_stale_before = s.get("stale")->at(0);
+  }
+
   const TaskStatsSnapshot before = robot_of();
+  const std::uint64_t produced_before = produced();
   const double stale_before = s.get("stale")->at(0);
   const std::int64_t t0 = s.now_ns();
   std::vector<std::uint32_t> commit;
@@ -85,6 +112,7 @@ configurations:
   s.run_for(20'000'000);  // the last switch's producer runs a few cycles
   const std::int64_t t1 = s.now_ns();
   const TaskStatsSnapshot after = robot_of();
+  const std::uint64_t produced_after = produced();
   const double stale = s.get("stale")->at(0) - stale_before;
   s.stop();
 
@@ -92,8 +120,11 @@ configurations:
   const double expected = static_cast<double>(t1 - t0) / 1e6;
   const double ran = static_cast<double>(after.cycles - before.cycles);
   const double missing = std::max(0.0, expected - ran - 1.0);  // one release of slack at either edge
+  // Exactly one producer runs each release: a gap (or a doubled release) at a switch shows as a
+  // difference between the staying task's cycles and the producers' together.
+  const double producer_gap = std::abs(ran - static_cast<double>(produced_after - produced_before));
   Fragment out;
-  out.result("switch_lost_cycles", missing + stale);
+  out.result("switch_lost_cycles", missing + producer_gap);
   std::vector<std::uint32_t> sorted = commit;
   auto stats = summary(sorted);
   if (!commit.empty()) {
@@ -108,8 +139,14 @@ configurations:
   d["robot_cycles_expected"] = expected;
   d["robot_releases_not_run"] = missing;
   d["robot_cycles_without_fresh_value"] = stale;
+  d["producer_cycles"] = static_cast<double>(produced_after - produced_before);
+  d["producer_gap"] = producer_gap;
   d["robot_missed_deadlines"] = after.missed - before.missed;
   d["robot_order_timeouts"] = after.order_timeouts - before.order_timeouts;
+  d["idle_s"] = static_cast<double>(idle_ns) * 1e-9;
+  d["idle_cycles_without_fresh_value"] = idle_stale;
+  d["idle_order_timeouts"] = idle_timeouts;
+  d["idle_missed_deadlines"] = idle_missed;
   d["commit_latency_ns"] = stats;
   out.samples(args, "switch_commit_latency", commit);
   return out.write(args);

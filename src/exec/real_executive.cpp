@@ -37,6 +37,29 @@ constexpr std::int64_t kReplyTimeoutNs = 10'000'000'000;
 constexpr int kTopFixedPriority = 80;
 constexpr int kLowestFixedPriority = 2;
 constexpr int kBackgroundPriority = 1;
+constexpr int kCommitPriority = 85;  // above every fixed priority (80 at most), below the dispatchers
+
+// Runs the calling thread at SCHED_FIFO `priority` while it lives (when real-time priorities are
+// wanted and granted), then puts back what it had. Not real-time safe.
+class ScopedPriority {
+ public:
+  ScopedPriority(bool realtime, int priority) {
+    if (!realtime || pthread_getschedparam(pthread_self(), &policy_, &param_) != 0) return;
+    sched_param sp{};
+    sp.sched_priority = priority;
+    raised_ = pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp) == 0;
+  }
+  ~ScopedPriority() {
+    if (raised_) pthread_setschedparam(pthread_self(), policy_, &param_);
+  }
+  ScopedPriority(const ScopedPriority&) = delete;
+  ScopedPriority& operator=(const ScopedPriority&) = delete;
+
+ private:
+  int policy_ = SCHED_OTHER;
+  sched_param param_{};
+  bool raised_ = false;
+};
 
 void warn_once(std::atomic<bool>& flag, const std::string& message) {
   if (!flag.exchange(true, std::memory_order_relaxed)) spdlog::warn("{}", message);  // a latch only
@@ -300,16 +323,21 @@ Result<void> RealExecutive::commit_switch(const std::vector<std::size_t>& leavin
     if (w.task->periodic())
       w.joining_k.store((commit_ns + w.task->period_ns() - 1) / w.task->period_ns(), std::memory_order_release);
   }
+  // The commit is timed to a cycle boundary: the control thread runs it at a real-time priority
+  // above the tasks', so that it is not the one that comes late.
+  const ScopedPriority urgent(realtime_, kCommitPriority);
   const std::vector<Mail> leave(leaving.size(), Mail{MailKind::kLeaveAt, Signal::kOff, epoch_ns_ + commit_ns});
   Result<void> r = post_all(leaving, leave);
   // Each joining task turns on right before its first release from the commit on, on its own
   // thread: not earlier, since on() publishes outputs a consumer may still be reading the leaving
-  // producer's last value of. They are all posted at once and answer as each turns on.
+  // producer's last value of. Its first release is the commit's even if the commit ran late
+  // (then it runs late): the leaving task ran none from there, and no release may go unproduced.
+  // They are all posted at once and answer as each turns on.
   std::vector<Mail> join;
   for (const std::size_t i : joining) {
     const Worker& w = *workers_[i];
     const std::int64_t p = w.task->periodic() ? w.task->period_ns() : 1;
-    join.push_back(Mail{MailKind::kOnAt, Signal::kOn, (std::max(commit_ns, now_ns()) + p - 1) / p});
+    join.push_back(Mail{MailKind::kOnAt, Signal::kOn, (commit_ns + p - 1) / p});
   }
   if (auto on = post_all(joining, join); r && !on) r = on;
   for (const std::size_t i : joining)

@@ -189,10 +189,9 @@ std::int64_t Worker::prepare() {
 }
 
 void Worker::act() {
-  if (on_at >= 0) {
-    join_now();
-    return;  // the loop prepares its first release, which has come
-  }
+  // A switch's joining task turns on and runs its first release at once: a consumer that shares
+  // its thread comes after it in the same pass and must find that release done.
+  if (on_at >= 0) join_now();
   if (task->state() != TaskState::kOn || held) return;
   const std::int64_t period = task->period_ns();
   const std::int64_t epoch = exec->epoch_ns();

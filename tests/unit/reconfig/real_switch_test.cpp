@@ -45,8 +45,18 @@ TEST(RealSwitch, SwitchesBackAndForthOnRealThreads) {
   s->run_for(10 * kMs);
   EXPECT_EQ(s->configuration(), "with_a");
   EXPECT_EQ(s->switches().size(), 40u);
+  ASSERT_TRUE(s->signal("robot", Signal::kOff).ok());  // off between two cycles
+  ASSERT_TRUE(s->signal("a", Signal::kOff).ok());      // and its producer, a release later at most
   const auto robot = stats_of(*s, "robot");
   EXPECT_GT(robot.cycles, 50u);
+  // Exactly one producer ran each of the robot's releases: no release went unproduced at a
+  // switch, even one whose commit ran late (they are late too: late: run), and none twice.
+  const std::uint64_t produced = stats_of(*s, "a").cycles + stats_of(*s, "b").cycles;
+  EXPECT_LE(robot.cycles, produced) << "a release no producer ran";
+  EXPECT_LE(produced, robot.cycles + 1) << "a release two producers ran";
+  // The robot waits at most half its deadline for a joining producer; a machine's stall can make
+  // it give up now and then, a broken commit would make it give up at every other switch.
+  EXPECT_LT(robot.order_timeouts, 10u);
   // A stale read happens only where the robot gave up waiting for its producer's release (the
   // bounded precedence wait), or where it ran so late that its next release had come (it then
   // reads what the joining task published at on(), or a newer release), both of which a loaded
