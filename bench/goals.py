@@ -32,6 +32,7 @@ KEYS = [
     Key("mutex_read_p99_contended_ns", "ns", "the same with a std::mutex"),
     Key("svt_read_p50_contended_ns", "ns", "reader p50 under the same writer"),
     Key("mutex_read_p50_contended_ns", "ns", "the same with a std::mutex"),
+    Key("cache_line_transfer_ns_p50", "ns", "one cache line moving between the two cores (the floor of both)"),
     Key("svt_ipc_latency_ns_p50", "ns", "latest value to another process: Chimera's table, p50"),
     Key("svt_ipc_latency_ns_p99", "ns", "the same, p99"),
     Key("iceoryx_latency_ns_p50", "ns", "the same through iceoryx 2.0, p50"),

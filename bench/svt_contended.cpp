@@ -6,7 +6,8 @@
 //
 //   svt_contended [--quick] [--out FILE] [--samples-dir DIR]
 //
-// Keys: svt_read_p99_contended_ns, mutex_read_p99_contended_ns.
+// Keys: svt_read_p99_contended_ns, mutex_read_p99_contended_ns, and the floor beneath both:
+// cache_line_transfer_ns_p50, one cache line moving between the two cores.
 
 #include <pthread.h>
 #include <sched.h>
@@ -80,6 +81,39 @@ Run contend(const TscClock& tsc, std::size_t n, Read read, WriterStep writer_ste
   return run;
 }
 
+/// The hardware's floor for the figures above: one cache line moving from one core to the other.
+/// Two threads bounce a counter on its own line, each waiting for the other's increment; a round
+/// trip is two transfers. Returns the one-way time of each of `n` round trips.
+std::vector<std::uint32_t> line_transfers(const TscClock& tsc, std::size_t n) {
+  struct alignas(64) Line {
+    std::atomic<std::uint64_t> value{0};
+  };
+  Line line;
+  std::thread echo([&] {
+    pin_to_cpu(kWriterCpu);
+    set_fifo(true);
+    for (std::uint64_t k = 1; k < 2 * n; k += 2) {
+      // Acquire and release: a ping-pong, each side's store is what the other waits for.
+      while (line.value.load(std::memory_order_acquire) != k) {
+      }
+      line.value.store(k + 1, std::memory_order_release);
+    }
+  });
+  std::vector<std::uint32_t> ns(n);
+  set_fifo(true);
+  for (std::uint64_t i = 0; i < n; ++i) {
+    const std::uint64_t a = TscClock::stamp();
+    line.value.store(2 * i + 1, std::memory_order_release);            // release: hands the line over
+    while (line.value.load(std::memory_order_acquire) != 2 * i + 2) {  // acquire: the echo's store
+    }
+    const std::uint64_t b = TscClock::stamp();
+    ns[i] = tsc.ns(a, b) / 2;
+  }
+  set_fifo(false);
+  echo.join();
+  return ns;
+}
+
 nlohmann::json describe(Run& run) {
   auto j = summary(run.ns);
   j["writes_during_run"] = run.writes;
@@ -140,6 +174,9 @@ int main(int argc, char** argv) {
         std::memcpy(guarded.data(), written.data(), sizeof(guarded));
       });
 
+  std::vector<std::uint32_t> transfers = line_transfers(tsc, n / 10);
+  out.details()["cache_line_transfer"] = summary(transfers);
+
   out.samples(args, "contended_svt", svt.ns);
   out.samples(args, "contended_mutex", mtx.ns);
   out.details()["svt"] = describe(svt);
@@ -150,6 +187,7 @@ int main(int argc, char** argv) {
   out.details()["writer_cpu"] = kWriterCpu;
   out.result("svt_read_p99_contended_ns", out.details()["svt"]["p99"].get<double>());
   out.result("mutex_read_p99_contended_ns", out.details()["mutex"]["p99"].get<double>());
+  out.result("cache_line_transfer_ns_p50", out.details()["cache_line_transfer"]["p50"].get<double>());
   out.result("svt_read_p50_contended_ns", out.details()["svt"]["p50"].get<double>());
   out.result("mutex_read_p50_contended_ns", out.details()["mutex"]["p50"].get<double>());
   return out.write(args);

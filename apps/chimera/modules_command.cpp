@@ -24,25 +24,24 @@ using Align = TextTable::Align;
 
 constexpr std::size_t kTextWidth = 100;
 
-// Module docs are written as long paragraphs; wrap them for a terminal, keeping their newlines.
-std::string wrap(std::string_view text, std::size_t width) {
-  std::string out;
+// Terminal columns of UTF-8 text: one per code point (the pages' ⁻¹, ·, Δ take one column each).
+std::size_t columns(std::string_view text) {
+  return static_cast<std::size_t>(
+      std::count_if(text.begin(), text.end(), [](char c) { return (static_cast<unsigned char>(c) & 0xC0U) != 0x80U; }));
+}
+
+// One line of prose wrapped for a terminal at `width`, words kept whole.
+void wrap_line(std::string_view line, std::size_t width, std::string& out) {
   std::size_t column = 0;
   std::size_t i = 0;
-  while (i < text.size()) {
-    if (text[i] == '\n') {
-      out += '\n';
-      column = 0;
+  while (i < line.size()) {
+    if (line[i] == ' ') {
       ++i;
       continue;
     }
-    if (text[i] == ' ') {
-      ++i;
-      continue;
-    }
-    const std::size_t end = std::min(text.find_first_of(" \n", i), text.size());
-    const std::string_view word = text.substr(i, end - i);
-    if (column > 0 && column + 1 + word.size() > width) {
+    const std::size_t end = std::min(line.find(' ', i), line.size());
+    const std::string_view word = line.substr(i, end - i);
+    if (column > 0 && column + 1 + columns(word) > width) {
       out += '\n';
       column = 0;
     } else if (column > 0) {
@@ -50,8 +49,29 @@ std::string wrap(std::string_view text, std::size_t width) {
       ++column;
     }
     out += word;
-    column += word.size();
+    column += columns(word);
     i = end;
+  }
+}
+
+// Module docs (Markdown) for a terminal: prose lines wrapped at `width`; indented code, fenced
+// code and table rows kept as they are, their spaces being their layout.
+std::string wrap(std::string_view text, std::size_t width) {
+  std::string out;
+  bool in_fence = false;
+  std::size_t start = 0;
+  while (start < text.size()) {
+    const std::size_t end = std::min(text.find('\n', start), text.size());
+    const std::string_view line = text.substr(start, end - start);
+    const bool fence = line.starts_with("```");
+    if (fence) in_fence = !in_fence;
+    if (fence || in_fence || line.starts_with(' ') || line.starts_with('|')) {
+      out += line;
+    } else {
+      wrap_line(line, width, out);
+    }
+    if (end < text.size()) out += '\n';
+    start = end + 1;
   }
   return out;
 }

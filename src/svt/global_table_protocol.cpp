@@ -1,27 +1,29 @@
-// GlobalTable's writes, reads and flag: the protocol of svt/seq_protocol.hpp applied to one
-// variable's block, located through the directory once per table (blocks_).
+// GlobalTable's split write, the reads registers cannot hold, and the flag: the protocol of
+// detail/seq_protocol.hpp applied to one variable's block (blocks_). The hot read and write are
+// inline: detail/global_table.inl.
 
 #include <array>
 #include <atomic>
 #include <cstring>
 
+#include "chimera/svt/detail/seq_protocol.hpp"
 #include "chimera/svt/global_table.hpp"
-#include "svt/seq_protocol.hpp"
 #include "svt/shm_layout.hpp"
 
 namespace chimera {
 
-namespace {
-
 namespace d = svt_detail;
+
+namespace {
 
 /// Stack scratch of read(): 512 B covers every joint-space vector; 8 KiB is the larger tier.
 constexpr std::size_t kSmallScratchWords = 64;
 constexpr std::size_t kLargeScratchWords = 1024;
 
-/// The reader of the protocol (GlobalTable::read_via). Here, not in read_via, so that read()
-/// inlines it: calls between a shared library's exported functions go through the PLT.
-inline ReadOutcome read_block(const d::BlockRef& b, void* dst, std::uint64_t seen, std::uint64_t* scratch) noexcept {
+/// The reader of the protocol for any size. Loads the words into `scratch` (at least b.words of
+/// them) and copies to `dst` only once they are known to be whole; with no scratch it loads
+/// straight into `dst`, and then on exhausted retries zeros dst and reports kNoData.
+ReadOutcome read_block(const d::BlockRef& b, void* dst, std::uint64_t seen, std::uint64_t* scratch) noexcept {
   for (int attempt = 0; attempt < d::kMaxReadAttempts; ++attempt) {
     const std::uint64_t now = d::read_version(b);
     if (now == 0) return {Freshness::kNoData, 0};
@@ -44,8 +46,7 @@ inline ReadOutcome read_block(const d::BlockRef& b, void* dst, std::uint64_t see
     std::memset(dst, 0, b.bytes);
     return {Freshness::kNoData, 0};
   }
-  // Starved: dst still holds the last complete value this reader got (none if seen is 0).
-  return {seen == 0 ? Freshness::kNoData : Freshness::kOld, seen};
+  return d::starved(seen);
 }
 
 }  // namespace
@@ -65,38 +66,23 @@ void GlobalTable::end_write(VarIndex v) noexcept {
   d::write_end(b, d::next_write(b));
 }
 
-void GlobalTable::write(VarIndex v, const void* src) noexcept {
+ReadOutcome GlobalTable::read_out_of_line(VarIndex v, void* dst, std::uint64_t seen,
+                                          std::uint64_t* scratch) const noexcept {
   const d::BlockRef& b = blocks_[v];
-  const std::uint64_t w = d::next_write(b);
-  d::write_begin(b, w);
-  d::write_all(b, w, static_cast<const std::byte*>(src));
-  d::write_end(b, w);
-}
-
-ReadOutcome GlobalTable::read_via(VarIndex v, void* dst, std::uint64_t seen, std::uint64_t* scratch) const noexcept {
-  return read_block(blocks_[v], dst, seen, scratch);
-}
-
-ReadOutcome GlobalTable::read(VarIndex v, void* dst, std::uint64_t seen) const noexcept {
-  const d::BlockRef& b = blocks_[v];
+  if (scratch != nullptr) return read_block(b, dst, seen, scratch);
   if (b.words <= kSmallScratchWords) {
-    std::array<std::uint64_t, kSmallScratchWords> scratch;  // NOLINT(*-member-init): loaded before use
-    return read_block(b, dst, seen, scratch.data());
+    std::array<std::uint64_t, kSmallScratchWords> own;  // NOLINT(*-member-init): loaded before use
+    return read_block(b, dst, seen, own.data());
   }
   if (b.words <= kLargeScratchWords) {
     // Out of line, so that small reads do not reserve 8 KiB of stack.
     auto large = [&]() __attribute__((noinline)) {
-      std::array<std::uint64_t, kLargeScratchWords> scratch;  // NOLINT(*-member-init): loaded before use
-      return read_block(b, dst, seen, scratch.data());
+      std::array<std::uint64_t, kLargeScratchWords> own;  // NOLINT(*-member-init): loaded before use
+      return read_block(b, dst, seen, own.data());
     };
     return large();
   }
   return read_block(b, dst, seen, nullptr);
-}
-
-std::uint64_t GlobalTable::version(VarIndex v) const noexcept {
-  // Acquire (in read_version): a caller that sees n may rely on write n being whole in its slot.
-  return d::read_version(blocks_[v]);
 }
 
 void GlobalTable::set_illegal_configuration(bool raised) noexcept {

@@ -20,14 +20,12 @@
 #include <new>
 #include <type_traits>
 
+#include "chimera/svt/detail/seq_protocol.hpp"  // kSlots, BlockRef
 #include "chimera/svt/elem_type.hpp"
 
 namespace chimera::svt_detail {
 
 inline constexpr std::size_t kCacheLine = 64;
-/// Slots per variable. Two would do for a writer preempted mid-write (the latch idea); four give
-/// a reader three whole writes of grace before a fast writer can reuse the slot it is copying.
-inline constexpr std::uint64_t kSlots = 4;
 /// "CHIMSVT1" read as a little-endian word: tells a chimera region from anything else in /dev/shm.
 inline constexpr std::uint64_t kMagic = 0x315456534d494843ULL;
 /// Bumped whenever anything in this file changes shape, so old and new binaries refuse each other.
@@ -81,21 +79,6 @@ T* object_at(std::byte* base, std::uint64_t offset) noexcept {
   // NOLINTNEXTLINE(cppcoreguidelines-pro-type-reinterpret-cast): the region is bytes, addressed by offset
   return std::launder(reinterpret_cast<T*>(base + offset));
 }
-
-/// The words of one variable's block, located once per operation.
-struct BlockRef {
-  std::uint64_t* version;  // its own cache line
-  std::byte* slots;        // slot k starts at slots + k * slot_stride
-  std::uint64_t slot_stride;
-  std::uint32_t words;
-  std::uint32_t bytes;  // payload bytes actually used (<= 8 * words)
-
-  [[nodiscard]] std::uint64_t* seq(std::uint64_t slot) const noexcept {
-    // NOLINTNEXTLINE(cppcoreguidelines-pro-type-reinterpret-cast): a slot starts with its seq word
-    return std::launder(reinterpret_cast<std::uint64_t*>(slots + slot * slot_stride));
-  }
-  [[nodiscard]] std::uint64_t* payload(std::uint64_t slot) const noexcept { return seq(slot) + 1; }
-};
 
 inline const DirEntry* dir_entry(std::byte* base, std::uint32_t v) noexcept {
   const auto* header = object_at<Header>(base, 0);

@@ -95,6 +95,15 @@ TEST_F(CliTest, ModulesShowsOneModule) {
     EXPECT_TRUE(contains(o.out, part)) << part << "\n" << o.out;
 }
 
+TEST_F(CliTest, ModulesKeepsThePageLayoutOfCodeAndTables) {
+  const auto o = chimera("modules pid_joint");
+  EXPECT_EXIT_CODE(o, 0);
+  // Indented code keeps its indent and its column alignment.
+  EXPECT_TRUE(contains(o.out, "\n    e_i     = theta_d_i - theta_m_i\n")) << o.out;
+  // A page line of 100 columns stays one line, though its ⁻¹ take more bytes than columns.
+  EXPECT_TRUE(contains(o.out, "and `i_max` lets the\nintegral supply")) << o.out;
+}
+
 TEST_F(CliTest, ModulesUnknownNameExitsTwo) {
   const auto o = chimera("modules nosuch");
   EXPECT_EXIT_CODE(o, 2);

@@ -2,6 +2,7 @@
 // freshness sequence, slot reuse, split writes, and the reader's steps against a lapping writer.
 // The multi-threaded tests are in tests/stress/svt.
 
+#include <algorithm>
 #include <array>
 #include <cstring>
 #include <optional>
@@ -9,8 +10,9 @@
 
 #include <gtest/gtest.h>
 
+#include "chimera/svt/detail/seq_protocol.hpp"
 #include "chimera/svt/global_table.hpp"
-#include "svt/seq_protocol.hpp"
+#include "svt/shm_layout.hpp"
 #include "unit/svt/svt_test_support.hpp"
 
 namespace chimera {
@@ -29,9 +31,24 @@ std::vector<std::byte> pattern(std::size_t bytes, int salt) {
 class ProtocolTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    vars_ = {{"f64x6", {ElemType::kF64, 6}},       {"f32x3", {ElemType::kF32, 3}},      {"i64x2", {ElemType::kI64, 2}},
-             {"i32x5", {ElemType::kI32, 5}},       {"u8x1", {ElemType::kU8, 1}},        {"u8x13", {ElemType::kU8, 13}},
-             {"f64x1024", {ElemType::kF64, 1024}}, {"f64x2000", {ElemType::kF64, 2000}}};
+    vars_ = {{"f64x6", {ElemType::kF64, 6}},
+             {"f32x3", {ElemType::kF32, 3}},
+             {"i64x2", {ElemType::kI64, 2}},
+             {"i32x5", {ElemType::kI32, 5}},
+             {"u8x1", {ElemType::kU8, 1}},
+             {"u8x13", {ElemType::kU8, 13}},
+             {"f64x1024", {ElemType::kF64, 1024}},
+             {"f64x2000", {ElemType::kF64, 2000}},
+             // Every size that reads go through registers for (1 to 8 whole words), and the first after.
+             {"f64x1", {ElemType::kF64, 1}},
+             {"f64x2", {ElemType::kF64, 2}},
+             {"f64x3", {ElemType::kF64, 3}},
+             {"f64x4", {ElemType::kF64, 4}},
+             {"f64x5", {ElemType::kF64, 5}},
+             {"f64x7", {ElemType::kF64, 7}},
+             {"f64x8", {ElemType::kF64, 8}},
+             {"f64x9", {ElemType::kF64, 9}},
+             {"u8x16", {ElemType::kU8, 16}}};
     auto t = GlobalTable::create(unique_subsystem("proto"), vars_);
     ASSERT_TRUE(t) << t.error().message;
     table_.emplace(std::move(*t));
@@ -56,6 +73,21 @@ TEST_F(ProtocolTest, EveryElementTypeAndSizeRoundTrips) {
       EXPECT_EQ(got, value) << vars_[v].name << " write " << k;
       EXPECT_EQ(table().version(v), static_cast<std::uint64_t>(k));
     }
+  }
+}
+
+TEST_F(ProtocolTest, ReadsIntoUnalignedBytes) {
+  for (VarIndex v = 0; v < vars_.size(); ++v) {
+    const std::size_t bytes = vars_[v].shape.bytes();
+    const auto value = pattern(bytes, 3);
+    table().write(v, value.data());
+    // One byte past an aligned start, with a guard byte either side that the read must not touch.
+    std::vector<std::byte> buffer(bytes + 2, std::byte{0xA5});
+    const ReadOutcome r = table().read(v, buffer.data() + 1, 0);
+    EXPECT_EQ(r.freshness, Freshness::kNew) << vars_[v].name;
+    EXPECT_TRUE(std::equal(value.begin(), value.end(), buffer.begin() + 1)) << vars_[v].name;
+    EXPECT_EQ(buffer.front(), std::byte{0xA5}) << vars_[v].name;
+    EXPECT_EQ(buffer.back(), std::byte{0xA5}) << vars_[v].name;
   }
 }
 

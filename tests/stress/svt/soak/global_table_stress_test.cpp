@@ -14,9 +14,10 @@
 
 #include <gtest/gtest.h>
 
+#include "chimera/svt/detail/seq_protocol.hpp"
 #include "chimera/svt/global_table.hpp"
 #include "chimera/svt/local_table.hpp"
-#include "svt/seq_protocol.hpp"
+#include "svt/shm_layout.hpp"
 #include "unit/svt/svt_test_support.hpp"
 
 namespace chimera {
@@ -118,7 +119,7 @@ TEST_P(StressTest, EveryReadIsWholeAndVersionsNeverGoBack) {
 }
 
 // 1024 uses read()'s larger stack scratch; 2000 has none and copies straight into the destination.
-INSTANTIATE_TEST_SUITE_P(Sizes, StressTest, ::testing::Values(1U, 6U, 36U, 1024U, 2000U));
+INSTANTIATE_TEST_SUITE_P(Sizes, StressTest, ::testing::Values(1U, 6U, 8U, 9U, 36U, 1024U, 2000U));
 
 TEST(LocalTableStress, PulledInputsAreWhole) {
   constexpr std::uint32_t kCount = 36;

@@ -1,6 +1,8 @@
 #pragma once
-// The state variable protocol (docs/state-variables.md), private to src/svt and its tests: a
-// sequence counter per slot, kSlots slots per variable, one writer per variable (rule 1).
+// The state variable protocol (docs/state-variables.md): a sequence counter per slot, kSlots slots
+// per variable, one writer per variable (rule 1). Installed because GlobalTable's reads and writes
+// are inline (detail/global_table.inl): a call into the library cost a 6-double read more than the
+// read itself. Not an API: only src/svt, the inline bodies and the protocol's tests use it.
 //
 // Writer of write w (w = version + 1):
 //   seq[w % kSlots] = 2w-1 (relaxed); release fence; payload words (relaxed);
@@ -12,7 +14,7 @@
 // races with the writer would be a data race, hence undefined behaviour (Boehm 2012).
 //
 // The reader is split into steps (open, copy, close) so that a test can run a writer between
-// them; GlobalTable::read_via composes them.
+// them; read_block (detail/global_table.inl) composes them.
 
 #include <algorithm>
 #include <atomic>
@@ -20,8 +22,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
-
-#include "svt/shm_layout.hpp"
+#include <new>
 
 // ThreadSanitizer does not model standalone fences, so under it the fences are replaced by
 // release stores and acquire loads of the payload words, which TSAN does understand.
@@ -34,6 +35,26 @@
 #endif
 
 namespace chimera::svt_detail {
+
+/// Slots per variable. Two would do for a writer preempted mid-write (the latch idea); four give
+/// a reader three whole writes of grace before a fast writer can reuse the slot it is copying.
+inline constexpr std::uint64_t kSlots = 4;
+
+/// The words of one variable's block (src/svt/shm_layout.hpp), located once per table in this
+/// process's mapping.
+struct BlockRef {
+  std::uint64_t* version;  // its own cache line
+  std::byte* slots;        // slot k starts at slots + k * slot_stride
+  std::uint64_t slot_stride;
+  std::uint32_t words;
+  std::uint32_t bytes;  // payload bytes actually used (<= 8 * words)
+
+  [[nodiscard]] std::uint64_t* seq(std::uint64_t slot) const noexcept {
+    // NOLINTNEXTLINE(cppcoreguidelines-pro-type-reinterpret-cast): a slot starts with its seq word
+    return std::launder(reinterpret_cast<std::uint64_t*>(slots + slot * slot_stride));
+  }
+  [[nodiscard]] std::uint64_t* payload(std::uint64_t slot) const noexcept { return seq(slot) + 1; }
+};
 
 using Word = std::atomic_ref<std::uint64_t>;
 
