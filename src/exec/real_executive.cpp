@@ -204,6 +204,13 @@ std::int64_t RealExecutive::now_ns() const { return monotonic_ns() - epoch_ns_; 
 
 int RealExecutive::fixed_priority(std::size_t index) const { return workers_[index]->fixed_priority; }
 
+std::optional<std::int64_t> RealExecutive::running_deadline(std::size_t index) const noexcept {
+  // Relaxed: a status word on its own (run_job); the watch only compares it with the clock.
+  const std::int64_t deadline = workers_[index]->running_deadline_ns.load(std::memory_order_relaxed);
+  if (deadline == Worker::kNever) return std::nullopt;
+  return deadline;
+}
+
 namespace {
 void* thread_entry(void* arg) {
   static_cast<TaskThread*>(arg)->main();

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <vector>
 
 #include "chimera/exec/task.hpp"
@@ -59,6 +60,9 @@ class RealExecutive {
   /// Someone other than a task wrote variable `v` (the operator's `set`): wakes the aperiodic
   /// tasks triggered by it. Not real-time safe.
   void variable_written(VarIndex v);
+  /// The absolute deadline (executive clock) of the job task `index` is running now, if it is
+  /// running one with a deadline; it names the job. Any thread; wait-free.
+  [[nodiscard]] std::optional<std::int64_t> running_deadline(std::size_t index) const noexcept;
   /// The SCHED_FIFO priority task `index` starts at (its fixed priority under rm and dm).
   [[nodiscard]] int fixed_priority(std::size_t index) const;
 

@@ -160,8 +160,11 @@ void Worker::publish_job(std::int64_t release_abs) {
 std::int64_t Worker::run_job(std::int64_t release_abs) {
   const std::int64_t epoch = exec->epoch_ns();
   const std::int64_t start = monotonic_ns();
+  // Relaxed: a status word, read on its own by the overrun watch; nothing is published with it.
+  running_deadline_ns.store(task->absolute_deadline(release_abs - epoch), std::memory_order_relaxed);
   (void)task->begin_job(release_abs - epoch, start - epoch);
   const std::int64_t used = task->end_job(monotonic_ns() - epoch, -1);
+  running_deadline_ns.store(kNever, std::memory_order_relaxed);  // relaxed: as above
   for (Worker* s : subscribers) {
     const int v = s->trigger_var.load(std::memory_order_relaxed);  // a hint; the flag below orders
     if (v < 0 || std::find(out_vars.begin(), out_vars.end(), v) == out_vars.end()) continue;

@@ -97,6 +97,10 @@ struct Worker {
   std::atomic<pthread_t> self{};
   std::atomic<int> current_priority{0};  // what it runs at (set by itself or its dispatcher)
 
+  // The job it is running, for the overrun watch (exec/overrun_watch.cpp): its absolute deadline
+  // (executive clock), which names the job; kNever while no job runs.
+  alignas(64) std::atomic<std::int64_t> running_deadline_ns{std::numeric_limits<std::int64_t>::max()};
+
   // Aperiodic triggers: the variable it waits on (-1: none), and an update not yet served.
   alignas(64) std::atomic<int> trigger_var{-1};
   std::atomic<bool> update_pending{false};

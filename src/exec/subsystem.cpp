@@ -113,17 +113,30 @@ Result<void> Subsystem::start() {
   }
   m.collect_events();
   // Real clock: a thread of the subsystem interface carries out the switches tasks ask for (the
-  // virtual clock does it in run_for, at the very instant they are asked for).
-  if (m.real_exec && !m.request_service.joinable())
-    m.request_service = std::thread([this] {
+  // virtual clock does it in run_for, at the very instant they are asked for) and watches for
+  // jobs overdue (a simulated job always ends).
+  if (m.real_exec && !m.service.joinable()) {
+    m.overdue_reported.assign(m.tasks.size(), -1);
+    m.service = std::thread([this] {
       Impl& self = *impl_;
+      std::uint32_t served = self.requests->changes().load(std::memory_order_acquire);  // acquire: the requests
+      serve_requests();
+      std::int64_t next_watch = monotonic_ns() + Impl::kWatchTickNs;
       for (;;) {
-        const std::uint32_t seen = self.requests->changes().load(std::memory_order_acquire);  // acquire: the requests
         if (self.service_stop.load(std::memory_order_acquire)) return;  // acquire: pairs with stop()
-        serve_requests();
-        (void)detail::futex_wait(self.requests->changes(), seen, -1);
+        const std::uint32_t now = self.requests->changes().load(std::memory_order_acquire);  // acquire: as above
+        if (now != served) {
+          served = now;
+          serve_requests();
+        }
+        if (monotonic_ns() >= next_watch) {
+          self.watch_overruns();
+          next_watch += Impl::kWatchTickNs;
+        }
+        (void)detail::futex_wait(self.requests->changes(), served, next_watch);
       }
     });
+  }
   return {};
 }
 
@@ -154,10 +167,10 @@ void Subsystem::run_for(std::int64_t ns) {
 
 void Subsystem::stop() {
   Impl& m = *impl_;
-  if (m.request_service.joinable()) {
+  if (m.service.joinable()) {
     m.service_stop.store(true, std::memory_order_release);  // release: the service sees it after its wake
     m.requests->wake();
-    m.request_service.join();
+    m.service.join();
   }
   std::lock_guard<std::mutex> lock(m.ops_mutex);
   if (m.stopped || !m.table) return;

@@ -2,6 +2,7 @@
 // The inside of a Subsystem, shared by the files that implement its parts: creation and signals
 // (exec/subsystem.cpp) and dynamic reconfiguration (reconfig/switch.cpp).
 
+#include <atomic>
 #include <cstring>
 #include <memory>
 #include <mutex>
@@ -54,10 +55,24 @@ struct Subsystem::Impl {
   std::unique_ptr<SubsystemRequestBoard> requests;
   std::vector<int> served;  // per task: the request last dealt with (-1: none)
   std::vector<SwitchRecord> history;
-  bool switching_flag = false;  // the flag is up for a switch that must create tasks
-  std::mutex ops_mutex;         // signals, switches and stop: from the shell or the request service
-  std::thread request_service;  // real clock: carries out the switches tasks ask for
+  // The flag is up for a switch that must create tasks. Relaxed: update_flag reads it under
+  // flag_mutex, and whoever changes it calls update_flag next.
+  std::atomic<bool> switching_flag{false};
+  std::mutex ops_mutex;  // signals, switches and stop: from the shell or the request service
+  // Real clock: carries out the switches tasks ask for, and every kWatchTickNs watches for jobs
+  // still running past their deadline (exec/overrun_watch.cpp).
+  std::thread service;
   std::atomic<bool> service_stop{false};
+
+  // The overrun watch: a job stuck in cycle() is a deadline miss that end_job would count only
+  // once it ends, perhaps never; the watch reports it while it lasts and, for a hard task, keeps
+  // the illegal-configuration flag up, so that the robot interfaces hold still.
+  static constexpr std::int64_t kWatchTickNs = 5'000'000;
+  std::vector<std::int64_t> overdue_reported;  // per task: the deadline of the job last reported (the service's)
+  std::atomic<int> hard_overdue{0};            // hard tasks with a job overdue now; relaxed, as switching_flag
+  std::mutex flag_mutex;                       // update_flag's reading of its inputs and storing of the flag
+  /// One look at every task's running job; reports the newly overdue, then updates the flag.
+  void watch_overruns();
 
   // The steps of a switch (reconfig/switch.cpp).
   /// Creates `to_spawn` in the background, publishing nothing; kills them again if one fails.
@@ -73,11 +88,16 @@ struct Subsystem::Impl {
   [[nodiscard]] std::int64_t shortest_period(const std::vector<std::size_t>& a,
                                              const std::vector<std::size_t>& b) const;
 
-  /// The illegal-configuration flag: up while a switch creates tasks, or while a task is in ERROR.
+  /// The illegal-configuration flag: up while a switch creates tasks, while a task is in ERROR, or
+  /// while a hard task's job runs past its deadline. From any thread of the interface; the one
+  /// who changes an input calls it next, so the last call sees the last inputs.
   void update_flag() {
-    bool error = false;
-    for (const auto& t : tasks) error = error || t->state() == TaskState::kError;
-    table->set_illegal_configuration(switching_flag || error);
+    std::lock_guard<std::mutex> lock(flag_mutex);
+    // Relaxed: both are read under flag_mutex, after their writer's change (see above).
+    bool raise = switching_flag.load(std::memory_order_relaxed) || hard_overdue.load(std::memory_order_relaxed) > 0;
+    for (const auto& t : tasks) raise = raise || t->state() == TaskState::kError;
+    // Stored only when it changes: every task polls the flag's line.
+    if (table->illegal_configuration() != raise) table->set_illegal_configuration(raise);
   }
 
   /// Moves every task's real-time events into `pending` and notes the last failure of each.

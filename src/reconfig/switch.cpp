@@ -198,10 +198,10 @@ Result<SwitchRecord> Subsystem::switch_locked(std::string_view name, std::string
 
   // A switch that must create tasks takes longer than a cycle: the flag tells every module so,
   // and critical ones (the robot interfaces) hold still until it is lowered.
-  m.switching_flag = record.flag_raised;
+  m.switching_flag.store(record.flag_raised, std::memory_order_relaxed);  // relaxed: see Impl::switching_flag
   m.update_flag();
   if (auto created = m.create_for_switch(plan->to_spawn); !created) {
-    m.switching_flag = false;
+    m.switching_flag.store(false, std::memory_order_relaxed);  // relaxed: see Impl::switching_flag
     m.update_flag();
     m.collect_events();
     return make_error(created.error().code,
@@ -215,7 +215,7 @@ Result<SwitchRecord> Subsystem::switch_locked(std::string_view name, std::string
   m.configuration = target->name;
   record.reinit = m.reinit_readers(changed_values(before, read_values(*m.table, consts)), plan->joining);
 
-  m.switching_flag = false;
+  m.switching_flag.store(false, std::memory_order_relaxed);  // relaxed: see Impl::switching_flag
   m.update_flag();
   m.requests->clear();
   std::fill(m.served.begin(), m.served.end(), -1);

@@ -5,6 +5,7 @@
 
 #include <unistd.h>
 
+#include <atomic>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -123,6 +124,49 @@ class FdReader : public Module {
   Out<std::int64_t> read_;
 };
 
+/// Set by a test to let every Staller's stuck cycle return.
+inline std::atomic<bool>& stall_released() {
+  static std::atomic<bool> released{false};
+  return released;
+}
+
+/// Its cycle number `stall_at` does not return until the test sets stall_released(): a job stuck
+/// in cycle(), for the overrun watch. Counts its cycles in out-var `done`. Real clock only.
+class Staller : public Module {
+ public:
+  static constexpr const char* kName = "staller";
+  static constexpr const char* kSummary = "a cycle that does not return until released";
+  static constexpr const char* kDoc = "cycle number stall_at waits for testing::stall_released()";
+  static void declare(Declarations& d, const Params&) {
+    d.out_var<std::int64_t>("done", Dim::fixed(1), "cycles run");
+    d.param("stall_at", 3.0, "cycles", "the cycle that gets stuck");
+    d.param("recover", false, "", "error() recovers");
+  }
+
+ protected:
+  Status init(InitContext& ctx) override {
+    stall_at_ = static_cast<std::int64_t>(ctx.params().number("stall_at"));
+    recover_ = ctx.params().flag("recover");
+    done_ = ctx.out<std::int64_t>("done");
+    return Status::ok();
+  }
+  Status cycle() override {
+    if (++cycles_ == stall_at_) {
+      // Acquire: pairs with the test's release store; nothing else is shared.
+      while (!stall_released().load(std::memory_order_acquire)) ::usleep(1000);
+    }
+    done_[0] = cycles_;
+    return Status::ok();
+  }
+  Status error() override { return recover_ ? Status::ok() : Status::fail("staller does not recover"); }
+
+ private:
+  std::int64_t stall_at_ = 0;
+  std::int64_t cycles_ = 0;
+  bool recover_ = false;
+  Out<std::int64_t> done_;
+};
+
 /// The probe registry's modules plus these, plus the library's cpu_load.
 inline Registry& scheduling_registry() {
   static Registry r = [] {
@@ -133,6 +177,7 @@ inline Registry& scheduling_registry() {
     (void)reg.add(info_of<Tracer>());
     (void)reg.add(info_of<UpdateCopier>());
     (void)reg.add(info_of<FdReader>());
+    (void)reg.add(info_of<Staller>());
     for (const char* library_module : {"cpu_load", "udp_command"})
       if (const ModuleInfo* m = Registry::global().find(library_module)) (void)reg.add(*m);
     return reg;

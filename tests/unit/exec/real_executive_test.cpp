@@ -6,6 +6,11 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <atomic>
+#include <string>
+#include <vector>
+
 #include <gtest/gtest.h>
 
 #include "chimera/config/loader.hpp"
@@ -151,6 +156,105 @@ TEST(RealExecutive, AUdpCommandReceiverTakesEveryDatagram) {
   EXPECT_EQ(s->get("command")->at(0), 50.0);
   EXPECT_EQ(s->get("command")->at(1), -1.0);
   s->stop();  // the task sleeps in poll(); kill must still reach it
+}
+
+}  // namespace
+}  // namespace chimera
+
+namespace chimera {
+namespace {
+
+/// Waits up to `limit` for an event of `task` containing `text`; the events seen are kept in `seen`.
+bool wait_for_event(Subsystem& s, const std::string& task, const std::string& text, std::vector<Event>& seen,
+                    std::int64_t limit = 5'000 * kMs) {
+  for (std::int64_t waited = 0; waited < limit; waited += 10 * kMs) {
+    for (auto& e : s.drain_events()) seen.push_back(std::move(e));
+    for (const auto& e : seen)
+      if (e.task == task && e.text.find(text) != std::string::npos) return true;
+    s.run_for(10 * kMs);
+  }
+  return false;
+}
+
+/// Lets every stuck Staller return when the test ends, passed or failed: declared after the
+/// subsystem, so destroyed before it, whose stop() would otherwise wait for the stuck job forever.
+struct ReleaseStallersAtExit {
+  ReleaseStallersAtExit() { testing::stall_released().store(false, std::memory_order_relaxed); }  // no thread yet
+  ~ReleaseStallersAtExit() {
+    testing::stall_released().store(true, std::memory_order_release);
+  }  // the staller's acquire
+  ReleaseStallersAtExit(const ReleaseStallersAtExit&) = delete;
+  ReleaseStallersAtExit& operator=(const ReleaseStallersAtExit&) = delete;
+};
+
+std::size_t count_events(const std::vector<Event>& seen, const std::string& task, const std::string& text) {
+  return static_cast<std::size_t>(std::count_if(seen.begin(), seen.end(), [&](const Event& e) {
+    return e.task == task && e.text.find(text) != std::string::npos;
+  }));
+}
+
+TEST(OverrunWatch, AHardJobStuckInCycleIsReportedWhileItLastsAndKeepsTheFlagUp) {
+  auto s = make(
+      "  - {name: stuck, module: staller, period: 10ms, params: {stall_at: 3}}\n"
+      // Another period: under rm, tasks of one CPU and one period share a thread, and a stuck
+      // job holds up the ones after it on its thread.
+      "  - {name: c, module: counter, period: 20ms, criticality: soft}\n");
+  const ReleaseStallersAtExit release_at_exit;
+  ASSERT_TRUE(s->start().ok());
+  std::vector<Event> seen;
+  ASSERT_TRUE(wait_for_event(*s, "stuck", "still running", seen)) << "no report while the job is stuck";
+  EXPECT_NE(seen.back().text.find("illegal-configuration flag is up"), std::string::npos) << seen.back().text;
+  // While it lasts: the flag is up, the task is still ON (its error() cannot run inside cycle()),
+  // and the other task runs on.
+  EXPECT_TRUE(s->table().illegal_configuration());
+  auto snap = s->snapshot();
+  EXPECT_EQ(snap[0].state, TaskState::kOn);
+  const auto counted = s->get("count")->at(0);
+  s->run_for(100 * kMs);
+  EXPECT_GT(s->get("count")->at(0), counted) << "the other task stops with the stuck one";
+  EXPECT_EQ(count_events(seen, "stuck", "still running"), 1u) << "one report per stuck job";
+  EXPECT_TRUE(s->table().illegal_configuration());
+
+  // Released: the job ends late, a hard task's miss: error() does not recover, so ERROR (and the
+  // flag stays up for that reason).
+  testing::stall_released().store(true, std::memory_order_release);  // release: the staller's acquire
+  ASSERT_TRUE(wait_for_event(*s, "stuck", "ERROR", seen));
+  for (auto& e : s->drain_events()) seen.push_back(std::move(e));
+  EXPECT_EQ(count_events(seen, "stuck", "still running"), 1u);
+  EXPECT_EQ(s->snapshot()[0].state, TaskState::kError);
+  EXPECT_TRUE(s->table().illegal_configuration());
+  s->stop();
+}
+
+TEST(OverrunWatch, TheFlagGoesDownWhenAStuckHardJobEndsAndItsTaskRecovers) {
+  auto s = make("  - {name: stuck, module: staller, period: 10ms, params: {stall_at: 2, recover: true}}\n");
+  const ReleaseStallersAtExit release_at_exit;
+  ASSERT_TRUE(s->start().ok());
+  std::vector<Event> seen;
+  ASSERT_TRUE(wait_for_event(*s, "stuck", "still running", seen));
+  EXPECT_TRUE(s->table().illegal_configuration());
+  testing::stall_released().store(true, std::memory_order_release);  // release: the staller's acquire
+  bool lowered = false;
+  for (int i = 0; i < 500 && !lowered; ++i) {
+    s->run_for(10 * kMs);
+    lowered = !s->table().illegal_configuration();
+  }
+  EXPECT_TRUE(lowered) << "the flag stayed up after the job ended and error() recovered";
+  EXPECT_EQ(s->snapshot()[0].state, TaskState::kOn);
+  EXPECT_GT(s->snapshot()[0].stats.missed, 0u) << "the late job is a counted miss";
+  s->stop();
+}
+
+TEST(OverrunWatch, ASoftJobStuckInCycleIsReportedWithoutTheFlag) {
+  auto s = make("  - {name: stuck, module: staller, period: 10ms, criticality: soft, params: {stall_at: 2}}\n");
+  const ReleaseStallersAtExit release_at_exit;
+  ASSERT_TRUE(s->start().ok());
+  std::vector<Event> seen;
+  ASSERT_TRUE(wait_for_event(*s, "stuck", "still running", seen));
+  EXPECT_NE(seen.back().text.find("Soft"), std::string::npos) << seen.back().text;
+  EXPECT_FALSE(s->table().illegal_configuration());
+  testing::stall_released().store(true, std::memory_order_release);  // release: the staller's acquire
+  s->stop();
 }
 
 }  // namespace
