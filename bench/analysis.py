@@ -108,15 +108,20 @@ def svt_contended(doc, plots):
     else:
         versus = f"; the mutex's p99 is lower in this run ({F(m99)}), its p99.9 and maximum are not"
     line = _d(doc, "svt_contended", "cache_line_transfer")
+    each = f"p50 {F(line['p50'])} in this run" if line else "80 to 100 ns on this virtual machine"
     transfer = (f"measured in this run by two threads bouncing one line between the cores, p50 {F(line['p50'])} "
                 f"one way (p99 {F(line['p99'])});" if line else "about 100 ns on this virtual machine;")
     out += [f"**Missed by how much:** p99 {F(p99)} against 100 ns, {p99 / 100:.1f}x{versus}.", "",
             "**Why.** Under a writer that never pauses, every read needs cache lines the other core has just "
             "written: the variable's `version` line, and then the slot's line (its `seq` and payload). "
-            "Each is a cross-core transfer, 80 to 100 ns on this virtual machine, and the second "
+            "Each is a cross-core transfer (" + each + "), and the second "
             "cannot start before the first has arrived, because which slot to read depends on "
-            "`version`. Two transfers in a row put the median near 165 ns and the p99 above it; no "
-            "arrangement of the copy itself changes that.", "",
+            "`version`: two transfers in a row are the median, and the p99 is a third (a line the "
+            "writer took back meanwhile). No arrangement of the copy itself changes that: in the "
+            "session that made reads inline and held them in registers, the p99 was 282 to 311 ns "
+            "whether the read went through registers or through the old scratch path, with a writer "
+            "writing 10 or 36 million times a second, and with eight slots instead of four; a run of "
+            "the old code on another day had 205 ns, so this figure moves with the machine.", "",
             "**What would close it.** Taking the two transfers in parallel. Tried: prefetching the four "
             "slots' first lines while `version` is loaded (a prefetch is a hint, not an access, so the "
             "protocol would be unchanged) brought the median from about 165 to 102 ns, one transfer, "
