@@ -19,6 +19,7 @@
 #include "chimera/config/loader.hpp"
 #include "chimera/exec/subsystem.hpp"
 #include "common/bench_util.hpp"
+#include "common/real_subsystem.hpp"
 
 namespace chimera::bench {
 namespace {
@@ -71,14 +72,7 @@ int main(int argc, char** argv) {
   }
   yaml += "configurations:\n  all: [" + names + "]\n";
   Fragment out;
-  auto spec = load_subsystem_text(yaml, "many_tasks.yaml", Registry::global());
-  if (!spec) {
-    std::fprintf(stderr, "%s\n", spec.error().message.c_str());
-    return 1;
-  }
-  RunOptions options;
-  options.clock = ClockKind::kReal;
-  auto sub = Subsystem::create(*spec, Registry::global(), options);
+  auto sub = real_subsystem(yaml, "many_tasks.yaml");
   if (!sub) {
     std::fprintf(stderr, "%s\n", sub.error().message.c_str());
     return 1;

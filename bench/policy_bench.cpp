@@ -18,6 +18,7 @@
 #include "chimera/config/loader.hpp"
 #include "chimera/exec/subsystem.hpp"
 #include "common/bench_util.hpp"
+#include "common/real_subsystem.hpp"
 
 int main(int argc, char** argv) {
   using namespace chimera;
@@ -35,15 +36,12 @@ tasks:
   - {{name: t2, module: cpu_load, period: 70ms, criticality: soft, late: run, params: {{exec: 0.035}}}}
 )",
                                          scheduler, ::getpid(), scheduler);
-    auto spec = load_subsystem_text(yaml, "policy_bench.yaml", Registry::global());
-    if (!spec) {
-      std::fprintf(stderr, "%s\n", spec.error().message.c_str());
+    auto sub = real_subsystem(yaml, "policy_bench.yaml");
+    if (!sub) {
+      std::fprintf(stderr, "%s\n", sub.error().message.c_str());
       return 1;
     }
-    RunOptions options;
-    options.clock = ClockKind::kReal;
-    auto sub = Subsystem::create(*spec, Registry::global(), options);
-    if (!sub || !(*sub)->start()) {
+    if (!(*sub)->start()) {
       std::fprintf(stderr, "%s: cannot start\n", scheduler);
       return 1;
     }

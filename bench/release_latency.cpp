@@ -31,6 +31,7 @@
 #include "chimera/config/loader.hpp"
 #include "chimera/exec/subsystem.hpp"
 #include "common/bench_util.hpp"
+#include "common/real_subsystem.hpp"
 #include "support/bench_modules.hpp"
 
 extern char** environ;  // NOLINT: POSIX
@@ -157,17 +158,10 @@ Half run_half(int cpu, int seconds, const std::string& cyclictest, const std::st
       "configurations:\n"
       "  run: [probe]\n",
       ::getpid(), cpu);
-  auto spec = load_subsystem_text(yaml, "release_latency.yaml", Registry::global());
-  if (!spec) {
-    h.error = spec.error().message;
-    return h;
-  }
   stamp_log().reserve(static_cast<std::size_t>(seconds) * 1000 + 4000);
 
   // Chimera first, so that its start (threads, mlockall) falls outside cyclictest's run.
-  RunOptions options;
-  options.clock = ClockKind::kReal;
-  auto sub = Subsystem::create(*spec, Registry::global(), options);
+  auto sub = real_subsystem(yaml, "release_latency.yaml");
   if (!sub) {
     h.error = sub.error().message;
     return h;

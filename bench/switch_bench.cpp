@@ -22,6 +22,7 @@
 #include "chimera/config/loader.hpp"
 #include "chimera/exec/subsystem.hpp"
 #include "common/bench_util.hpp"
+#include "common/real_subsystem.hpp"
 
 int main(int argc, char** argv) {
   using namespace chimera;
@@ -43,14 +44,7 @@ configurations:
   with_b: [b, robot]
 )",
                                        ::getpid());
-  auto spec = load_subsystem_text(yaml, "switch_bench.yaml", Registry::global());
-  if (!spec) {
-    std::fprintf(stderr, "%s\n", spec.error().message.c_str());
-    return 1;
-  }
-  RunOptions options;
-  options.clock = ClockKind::kReal;
-  auto sub = Subsystem::create(*spec, Registry::global(), options);
+  auto sub = real_subsystem(yaml, "switch_bench.yaml");
   if (!sub) {
     std::fprintf(stderr, "%s\n", sub.error().message.c_str());
     return 1;
