@@ -23,7 +23,7 @@ DEMO_CMD ?= scripts/demo.sh $(BUILD_DIR) 5
 
 # What `make format` and `make tidy` look at.
 FORMAT_DIRS := include src modules sim apps tests bench
-TIDY_DIRS ?= src
+TIDY_DIRS ?= src modules sim apps
 
 .PHONY: help setup setup-lint setup-bench build build-bench test check demo bench bench-quick format format-check tidy clean
 

@@ -26,7 +26,7 @@ class CpuLoad final : public Module {
   static constexpr const char* kSummary = docs::cpu_load::kSummary;
   static constexpr const char* kDoc = docs::cpu_load::kText;
 
-  static void declare(Declarations& d, const Params&) {
+  static void declare(Declarations& d, const Params& /*params*/) {
     d.param("exec", 0.0, "s", "execution time of each cycle");
     d.param("overrun_every", 0.0, "cycles", "every this many cycles one lasts longer (0: never)");
     d.param("overrun", 0.0, "s", "how much longer that cycle lasts");
