@@ -19,8 +19,8 @@
 
 #include "chimera/config/loader.hpp"
 #include "chimera/config/verify.hpp"
-#include "chimera/exec/task.hpp"
 #include "chimera/svt/global_table.hpp"
+#include "exec/task.hpp"
 
 namespace chimera::bench {
 namespace {

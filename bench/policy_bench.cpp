@@ -16,7 +16,7 @@
 #include <fmt/format.h>
 
 #include "chimera/config/loader.hpp"
-#include "chimera/exec/subsystem.hpp"
+#include "chimera/control/subsystem.hpp"
 #include "common/bench_util.hpp"
 #include "common/real_subsystem.hpp"
 

@@ -29,7 +29,7 @@
 #include <fmt/format.h>
 
 #include "chimera/config/loader.hpp"
-#include "chimera/exec/subsystem.hpp"
+#include "chimera/control/subsystem.hpp"
 #include "common/bench_util.hpp"
 #include "common/real_subsystem.hpp"
 #include "support/bench_modules.hpp"

@@ -12,6 +12,7 @@ install(TARGETS chimera_lib EXPORT chimeraTargets
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 install(DIRECTORY include/chimera DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+install(FILES ${CHIMERA_GENERATED_INCLUDE_DIR}/chimera/module_abi.hpp DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/chimera)
 install(EXPORT chimeraTargets NAMESPACE chimera:: DESTINATION ${_chimera_cmake_dir})
 
 # The installed chimera command finds libchimera beside it in any prefix, not only in /usr.

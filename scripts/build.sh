@@ -5,7 +5,8 @@
 #
 # Uses ccache when it is installed. Warnings become errors when CI=true (or CHIMERA_WERROR=ON is
 # set in the environment); both are passed on every call, so a tree follows the current setting.
-# JOBS (default 2) bounds the parallel compile jobs; CONFIGURE_ONLY=1 stops after configuring.
+# JOBS (default 2) bounds the parallel compile jobs; CONFIGURE_ONLY=1 stops after configuring;
+# BUILD_TARGETS (space-separated) builds only those targets and what they need.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
@@ -45,4 +46,6 @@ cmake -S . -B "${dir}" "${args[@]}" "$@" >"${log}" 2>&1 || {
   exit 1
 }
 [[ "${CONFIGURE_ONLY:-0}" == 1 ]] && exit 0
-cmake --build "${dir}" --parallel "${JOBS:-2}"
+targets=()
+for t in ${BUILD_TARGETS:-}; do targets+=(--target "${t}"); done
+cmake --build "${dir}" --parallel "${JOBS:-2}" "${targets[@]+"${targets[@]}"}"

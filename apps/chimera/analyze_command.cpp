@@ -19,6 +19,7 @@
 #include "chimera/config/loader.hpp"
 #include "chimera/config/verify.hpp"
 #include "chimera/control/timing_table.hpp"
+#include "chimera/core/duration_text.hpp"
 #include "chimera/module/registry.hpp"
 #include "commands.hpp"
 #include "exit_codes.hpp"

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "chimera/analysis/task_model.hpp"
-#include "chimera/exec/subsystem.hpp"
+#include "chimera/control/subsystem.hpp"
 
 namespace CLI {  // NOLINT(readability-identifier-naming): CLI11's namespace, forward-declared
 class App;

@@ -11,6 +11,7 @@
 #include <spdlog/spdlog.h>
 
 #include "chimera/config/loader.hpp"
+#include "chimera/module/version.hpp"
 #include "commands.hpp"
 #include "exit_codes.hpp"
 
@@ -42,6 +43,7 @@ int run_main(int argc, char** argv) {
 
   CLI::App app{"Dynamically reconfigurable real-time software from port-based objects.", "chimera"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", chimera::version_text());
 
   chimera::cli::VerifyArgs verify;
   std::string verify_config;

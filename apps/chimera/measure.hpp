@@ -7,8 +7,8 @@
 
 #include "chimera/analysis/wcet_profile.hpp"
 #include "chimera/config/subsystem.hpp"
+#include "chimera/control/subsystem.hpp"
 #include "chimera/core/result.hpp"
-#include "chimera/exec/subsystem.hpp"
 
 namespace chimera::cli {
 

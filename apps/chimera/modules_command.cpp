@@ -10,7 +10,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include "chimera/control/text_table.hpp"
+#include "chimera/core/text_table.hpp"
 #include "chimera/module/plugin_loader.hpp"
 #include "chimera/module/registry.hpp"
 #include "commands.hpp"

@@ -11,6 +11,7 @@
 #include "chimera/analysis/wcet_profile.hpp"
 #include "chimera/config/loader.hpp"
 #include "chimera/control/timing_table.hpp"
+#include "chimera/core/duration_text.hpp"
 #include "commands.hpp"
 #include "exit_codes.hpp"
 #include "load_file.hpp"

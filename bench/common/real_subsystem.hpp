@@ -5,7 +5,7 @@
 #include <string>
 
 #include "chimera/config/loader.hpp"
-#include "chimera/exec/subsystem.hpp"
+#include "chimera/control/subsystem.hpp"
 #include "chimera/module/registry.hpp"
 
 namespace chimera::bench {

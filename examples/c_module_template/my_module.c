@@ -49,12 +49,13 @@ static chimera_status my_module_cycle(void* self) {
 }
 
 static const chimera_c_module my_module = {
-    .abi_version = CHIMERA_C_ABI_VERSION,
+    CHIMERA_C_MODULE_STAMP,
     .name = "my_module",
     .summary = "first-order low-pass filter, in C",
-    .doc = "Each channel of y follows u through tau dy/dt = u - y, discretised by backward Euler: "
-           "y_k = y_(k-1) + (u_k - y_(k-1)) dt / (tau + dt), dt the task's period. y starts at 0 "
-           "when the task is turned on.",
+    .doc =
+        "Each channel of y follows u through tau dy/dt = u - y, discretised by backward Euler: "
+        "y_k = y_(k-1) + (u_k - y_(k-1)) dt / (tau + dt), dt the task's period. y starts at 0 "
+        "when the task is turned on.",
     .state_size = sizeof(my_module_state),
     .declare = my_module_declare,
     .init = my_module_init,

@@ -5,8 +5,8 @@
 #include <limits>
 #include <optional>
 
-#include "analysis/detail/wide.hpp"
 #include "chimera/analysis/utilisation.hpp"
+#include "detail/wide.hpp"
 
 namespace chimera::analysis {
 namespace {

@@ -5,13 +5,12 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include "analysis/detail/duration_text.hpp"
-#include "chimera/control/text_table.hpp"
+#include "chimera/core/duration_text.hpp"
+#include "chimera/core/text_table.hpp"
 
 namespace chimera::analysis {
 namespace {
 
-using detail::duration_text;
 using Align = TextTable::Align;
 
 std::string utilisation_text(const CpuResult& cpu) {
@@ -28,7 +27,7 @@ std::string edf_test_text(const EdfTest& edf) {
   if (edf.outcome == EdfOutcome::kOverloaded) return edf_outcome_text(edf);
   if (edf.utilisation_decides) return "every D >= T, so U <= 1 decides: " + edf_outcome_text(edf);
   return fmt::format("some D < T: processor demand h(t) <= t checked up to L = {} (QPA, {} point{}): {}",
-                     duration_text(edf.bound_ns), edf.points, edf.points == 1 ? "" : "s", edf_outcome_text(edf));
+                     exact_duration_text(edf.bound_ns), edf.points, edf.points == 1 ? "" : "s", edf_outcome_text(edf));
 }
 
 // The line under a CPU's heading: utilisation, bound, and the test that decided.
@@ -62,14 +61,14 @@ std::string test_line(const CpuResult& cpu, std::span<const TaskModel> tasks) {
 
 std::string c_text(const TaskModel& t) {
   if (t.server)
-    return fmt::format("{} + {}", t.wcet_ns > 0 ? duration_text(t.wcet_ns) : "?",
-                       t.job_wcet_ns > 0 ? duration_text(t.job_wcet_ns) : "?");
-  return t.wcet_ns > 0 ? duration_text(t.wcet_ns) : "?";
+    return fmt::format("{} + {}", t.wcet_ns > 0 ? exact_duration_text(t.wcet_ns) : "?",
+                       t.job_wcet_ns > 0 ? exact_duration_text(t.job_wcet_ns) : "?");
+  return t.wcet_ns > 0 ? exact_duration_text(t.wcet_ns) : "?";
 }
 
 std::string response_text(const TaskResult& r) {
   if (r.response_ns <= 0) return "-";
-  return (r.response_is_bound ? "<= " : "") + duration_text(r.response_ns);
+  return (r.response_is_bound ? "<= " : "") + exact_duration_text(r.response_ns);
 }
 
 std::string verdict_text(const TaskResult& r) {
@@ -94,8 +93,9 @@ std::string cpu_section(const CpuResult& cpu, std::span<const TaskModel> tasks) 
     const TaskModel& t = tasks[r.index];
     const bool periodic = !is_background(t);
     table.add_row({t.name, t.cpu >= 0 ? "pinned" : "assigned", t.hard ? "hard" : "soft", c_text(t),
-                   std::string(wcet_source_name(t.wcet_source)), periodic ? duration_text(t.period_ns) : "aperiodic",
-                   periodic ? duration_text(relative_deadline(t)) : "-", response_text(r), verdict_text(r)});
+                   std::string(wcet_source_name(t.wcet_source)),
+                   periodic ? exact_duration_text(t.period_ns) : "aperiodic",
+                   periodic ? exact_duration_text(relative_deadline(t)) : "-", response_text(r), verdict_text(r)});
   }
   const std::string rendered = table.render();
   for (std::string_view rest = rendered; !rest.empty();) {
@@ -133,7 +133,7 @@ std::string format_report(const ReportContext& context, std::span<const TaskMode
       "{}: configuration '{}', {} task{} under {} on cpu{} {}; every C includes {} of "
       "framework overhead per cycle\n",
       context.file, context.configuration, tasks.size(), tasks.size() == 1 ? "" : "s", scheduler,
-      result.cpus.size() == 1 ? "" : "s", cpu_list(result), duration_text(context.options.overhead_ns));
+      result.cpus.size() == 1 ? "" : "s", cpu_list(result), exact_duration_text(context.options.overhead_ns));
   if (!context.measured_note.empty()) out += context.measured_note + "\n";
   for (const auto& cpu : result.cpus) out += cpu_section(cpu, tasks);
 

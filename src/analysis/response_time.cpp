@@ -4,8 +4,8 @@
 #include <limits>
 #include <numeric>
 
-#include "analysis/detail/wide.hpp"
 #include "chimera/analysis/utilisation.hpp"
+#include "detail/wide.hpp"
 
 namespace chimera::analysis {
 namespace {

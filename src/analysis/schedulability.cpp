@@ -5,15 +5,13 @@
 
 #include <fmt/format.h>
 
-#include "analysis/detail/duration_text.hpp"
 #include "chimera/analysis/muf.hpp"
 #include "chimera/analysis/response_time.hpp"
 #include "chimera/analysis/utilisation.hpp"
+#include "chimera/core/duration_text.hpp"
 
 namespace chimera::analysis {
 namespace {
-
-using detail::duration_text;
 
 constexpr std::string_view kBackgroundReason = "aperiodic without a server: runs when nothing else does";
 
@@ -74,8 +72,8 @@ std::string rta_reason(const ResponseTime& rt, const Demand& d) {
   switch (rt.outcome) {
     case RtaOutcome::kMeets: return {};
     case RtaOutcome::kMisses:
-      return fmt::format("response time {}{} > deadline {}", rt.exact ? "" : "at least ", duration_text(rt.response_ns),
-                         duration_text(d.d_ns));
+      return fmt::format("response time {}{} > deadline {}", rt.exact ? "" : "at least ",
+                         exact_duration_text(rt.response_ns), exact_duration_text(d.d_ns));
     case RtaOutcome::kOverloaded:
       return fmt::format("overloaded: it and the tasks at or above its priority need {:.3f} of the processor",
                          rt.level_utilisation);
@@ -210,8 +208,8 @@ std::string edf_failure_reason(const EdfTest& test) {
     case EdfOutcome::kFeasible: return {};
     case EdfOutcome::kOverloaded: return fmt::format("overloaded: U = {:.3f} > 1", test.utilisation);
     case EdfOutcome::kDemandExceeded:
-      return fmt::format("the jobs due in the first {} need {}", duration_text(test.interval_ns),
-                         duration_text(test.demand_ns));
+      return fmt::format("the jobs due in the first {} need {}", exact_duration_text(test.interval_ns),
+                         exact_duration_text(test.demand_ns));
     case EdfOutcome::kGaveUp: return "the interval the processor-demand test must check could not be bounded";
   }
   return {};

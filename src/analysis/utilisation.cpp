@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "analysis/detail/wide.hpp"
+#include "detail/wide.hpp"
 
 namespace chimera::analysis {
 

@@ -12,7 +12,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include "analysis/detail/duration_text.hpp"
+#include "chimera/core/duration_text.hpp"
 #include "config/detail/yaml_reader.hpp"
 
 namespace chimera::analysis {
@@ -21,8 +21,6 @@ namespace {
 using config_detail::Field;
 using config_detail::MapReader;
 using config_detail::Source;
-using detail::duration_text;
-using detail::DurationStyle;
 
 Result<std::int64_t> read_positive_duration(const Source& source, const Field& field) {
   auto ns = config_detail::read_duration(source, field);
@@ -97,7 +95,7 @@ Result<WcetProfile> read_profile(const Source& source, std::string_view text) {
   if (!tasks) return tasks.error();
   if (auto ok = config_detail::check_free_keys(source, *tasks, "tasks"); !ok) return ok.error();
   for (const auto& [value, task] : config_detail::entries(*tasks)) {
-    if (!config_detail::is_identifier(task)) return source.fail(value, "not a task name");
+    if (!is_identifier(task)) return source.fail(value, "not a task name");
     auto entry = read_entry(source, value, task);
     if (!entry) return entry.error();
     profile.tasks.push_back(*std::move(entry));
@@ -107,8 +105,8 @@ Result<WcetProfile> read_profile(const Source& source, std::string_view text) {
 
 std::string optional_fields(const ProfileEntry& e) {
   std::string out;
-  if (e.exec_max_ns) out += fmt::format(", exec_max: {}", duration_text(*e.exec_max_ns, DurationStyle::kFile));
-  if (e.exec_p99_ns) out += fmt::format(", exec_p99: {}", duration_text(*e.exec_p99_ns, DurationStyle::kFile));
+  if (e.exec_max_ns) out += fmt::format(", exec_max: {}", exact_duration_text(*e.exec_max_ns, DurationStyle::kFile));
+  if (e.exec_p99_ns) out += fmt::format(", exec_p99: {}", exact_duration_text(*e.exec_p99_ns, DurationStyle::kFile));
   if (e.cycles) out += fmt::format(", cycles: {}", *e.cycles);
   return out;
 }
@@ -154,7 +152,7 @@ std::string format_wcet_profile(const WcetProfile& profile) {
   if (profile.tasks.empty()) return out + "tasks: {}\n";
   out += "tasks:\n";
   for (const auto& e : profile.tasks)
-    out += fmt::format("  {}: {{ wcet: {}{} }}\n", e.task, duration_text(e.wcet_ns, DurationStyle::kFile),
+    out += fmt::format("  {}: {{ wcet: {}{} }}\n", e.task, exact_duration_text(e.wcet_ns, DurationStyle::kFile),
                        optional_fields(e));
   return out;
 }

@@ -13,9 +13,9 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include "config/detail/request_loader.hpp"
-#include "config/detail/task_loader.hpp"
-#include "config/detail/yaml_reader.hpp"
+#include "detail/request_loader.hpp"
+#include "detail/task_loader.hpp"
+#include "detail/yaml_reader.hpp"
 
 namespace chimera {
 namespace {
@@ -94,7 +94,7 @@ Result<void> read_constants(const Source& source, const MapReader& top, Subsyste
   if (!f) return {};
   if (auto ok = config_detail::check_free_keys(source, *f, "constants"); !ok) return ok.error();
   for (const auto& [value, name] : entries(*f)) {
-    if (!config_detail::is_identifier(name))
+    if (!is_identifier(name))
       return source.fail(value, "not a valid variable name (letters, digits and _, not starting with a digit)");
     auto numbers = config_detail::read_numbers(source, value);
     if (!numbers) return numbers.error();
@@ -134,7 +134,7 @@ Result<void> read_configurations(const Source& source, const MapReader& top, Sub
   if (f->node.IsNull() || f->node.size() == 0)
     return source.fail(*f, "needs at least one configuration (or leave the key out: all tasks form one)");
   for (const auto& [value, name] : entries(*f)) {
-    if (!config_detail::is_identifier(name))
+    if (!is_identifier(name))
       return source.fail(value, "not a valid configuration name (letters, digits and _, not starting with a digit)");
     if (!value.node.IsSequence())
       return source.fail(value, fmt::format("must be a list of task names, e.g. [traj, pid, robot], not {}",

@@ -9,7 +9,7 @@
 #include <fmt/format.h>
 
 #include "chimera/config/verify.hpp"
-#include "config/detail/text.hpp"
+#include "detail/text.hpp"
 
 namespace chimera {
 namespace {

@@ -10,7 +10,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include "config/detail/text.hpp"
+#include "detail/text.hpp"
 
 namespace chimera {
 namespace {

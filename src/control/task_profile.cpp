@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "chimera/control/timing_table.hpp"
+#include "chimera/core/duration_text.hpp"
 
 namespace chimera {
 

@@ -2,15 +2,12 @@
 
 #include <fmt/format.h>
 
-#include "chimera/control/text_table.hpp"
+#include "chimera/core/duration_text.hpp"
+#include "chimera/core/text_table.hpp"
 
 namespace chimera {
 
 namespace {
-
-constexpr std::int64_t kUs = 1'000;
-constexpr std::int64_t kMs = 1'000'000;
-constexpr std::int64_t kS = 1'000'000'000;
 
 using Align = TextTable::Align;
 
@@ -30,26 +27,6 @@ std::vector<std::string> identity_cells(const TaskSnapshot& t) {
 }
 
 }  // namespace
-
-std::string format_duration(std::int64_t ns) {
-  const auto v = static_cast<double>(ns);
-  const std::int64_t magnitude = ns < 0 ? -ns : ns;
-  if (magnitude < kUs) return fmt::format("{} ns", ns);
-  if (magnitude < kMs) return fmt::format("{:.1f} µs", v / kUs);
-  if (magnitude < kS) return fmt::format("{:.2f} ms", v / kMs);
-  return fmt::format("{:.3f} s", v / kS);
-}
-
-std::string format_period(std::int64_t ns) {
-  if (ns <= 0) return "aperiodic";
-  // Exact values read as the file wrote them; others (e.g. from a frequency) fall back.
-  if (ns % kS == 0) return fmt::format("{} s", ns / kS);
-  if (ns >= kMs && ns % kMs == 0) return fmt::format("{} ms", ns / kMs);
-  if (ns >= kUs && ns % kUs == 0) return fmt::format("{} µs", ns / kUs);
-  if (ns < kUs) return fmt::format("{} ns", ns);
-  if (ns < kMs) return fmt::format("{:.3f} µs", static_cast<double>(ns) / kUs);
-  return fmt::format("{:.3f} ms", static_cast<double>(ns) / kMs);
-}
 
 std::string status_table(std::span<const TaskSnapshot> tasks) {
   bool any_error = false;

@@ -121,9 +121,9 @@ void PriorityDispatcher::rerank() {
   const std::vector<TaskUrgency>& urgency = urgency_[flips % 2];
   for (std::size_t i = 0; i < workers_.size(); ++i) {
     const Worker& w = *workers_[i];
-    active_[i] = w.job_active.load(std::memory_order_acquire);  // acquire: its release and deadline
+    active_[i] = w.job.active.load(std::memory_order_acquire);  // acquire: its release and deadline
     jobs_[i] =
-        JobUrgency{w.job_release_ns.load(std::memory_order_relaxed), w.job_deadline_ns.load(std::memory_order_relaxed)};
+        JobUrgency{w.job.release_ns.load(std::memory_order_relaxed), w.job.deadline_ns.load(std::memory_order_relaxed)};
   }
   rank(policy_, urgency, jobs_, active_, order_, priorities_);
   taken_.store(flips, std::memory_order_release);  // release: done with the other set
@@ -133,12 +133,12 @@ void PriorityDispatcher::rerank() {
   // same time (it preempts them), so the two writers of current_priority never overlap.
   for (std::size_t i = 0; i < workers_.size(); ++i) {
     Worker& w = *workers_[i];
-    if (!active_[i] || priorities_[i] == w.current_priority.load(std::memory_order_relaxed)) continue;
+    if (!active_[i] || priorities_[i] == w.job.current_priority.load(std::memory_order_relaxed)) continue;
     sched_param sp{};
     sp.sched_priority = priorities_[i];
-    // The acquire load of job_active ordered the worker's own store of `self` before it.
-    if (pthread_setschedparam(w.self.load(std::memory_order_relaxed), SCHED_FIFO, &sp) == 0)
-      w.current_priority.store(priorities_[i], std::memory_order_relaxed);
+    // The acquire load of job.active ordered the worker's own store of `self` before it.
+    if (pthread_setschedparam(w.job.self.load(std::memory_order_relaxed), SCHED_FIFO, &sp) == 0)
+      w.job.current_priority.store(priorities_[i], std::memory_order_relaxed);
   }
 }
 

@@ -21,6 +21,7 @@
 #include "futex.hpp"
 #include "priority_dispatcher.hpp"
 #include "real_worker.hpp"
+#include "release_policy.hpp"
 
 namespace chimera {
 
@@ -37,7 +38,8 @@ constexpr std::int64_t kReplyTimeoutNs = 10'000'000'000;
 constexpr int kTopFixedPriority = 80;
 constexpr int kLowestFixedPriority = 2;
 constexpr int kBackgroundPriority = 1;
-constexpr int kCommitPriority = 85;  // above every fixed priority (80 at most), below the dispatchers
+constexpr int kCommitPriority = 85;                // above every fixed priority (80 at most), below the dispatchers
+constexpr std::int64_t kCommitMarginNs = 200'000;  // time to post a switch's commit before its boundary
 
 // Runs the calling thread at SCHED_FIFO `priority` while it lives (when real-time priorities are
 // wanted and granted), then puts back what it had. Not real-time safe.
@@ -102,16 +104,31 @@ void prepare_realtime_process(bool realtime) {
                                           std::generic_category().message(errno)));
 }
 
-RealExecutive::RealExecutive(const std::vector<Task*>& tasks, const ReleaseOrder& order, const SchedulePlan& plan,
-                             bool realtime, const GlobalTable& table)
-    : table_(table), epoch_ns_(monotonic_ns()), realtime_(realtime) {
-  make_workers(tasks, plan);
-  link_workers(order);
-  if (!is_fixed_priority(plan.policy)) make_dispatchers(plan);
-  form_threads(order);
+RealExecutive::RealExecutive(ExecutiveSetup setup)
+    : subsystem_(*setup.subsystem),
+      table_(setup.table),
+      events_(setup.events),
+      tasks_(std::move(setup.tasks)),
+      order_(compute_release_order(subsystem_)),
+      plan_(make_schedule_plan(subsystem_, order_, subsystem_cpus(*subsystem_.spec), setup.configuration)),
+      cpus_(plan_.cpu),
+      epoch_ns_(monotonic_ns()),
+      realtime_(setup.realtime_priorities) {
+  prepare_realtime_process(realtime_);
+  for (Task* t : tasks_) {
+    t->set_virtual_clock(false);
+    if (setup.measure_cpu_time || t->spec().wcet_ns) t->set_exec_clock(Task::ExecClock::kCpu);
+  }
+  make_workers(plan_);
+  link_workers();
+  if (!is_fixed_priority(plan_.policy)) make_dispatchers(plan_);
+  form_threads();
+  overdue_reported_.assign(tasks_.size(), -1);
+  overdue_hold_.assign(tasks_.size(), false);
 }
 
-void RealExecutive::make_workers(const std::vector<Task*>& tasks, const SchedulePlan& plan) {
+void RealExecutive::make_workers(const SchedulePlan& plan) {
+  const std::vector<Task*>& tasks = tasks_;
   const std::vector<int> priorities = fixed_priorities(plan);
   for (std::size_t i = 0; i < tasks.size(); ++i) {
     auto w = std::make_unique<Worker>();
@@ -128,16 +145,17 @@ void RealExecutive::make_workers(const std::vector<Task*>& tasks, const Schedule
     }
     for (const auto& b : tasks[i]->resolved().bindings)
       if (b.kind == PortKind::kOutVar)
-        if (auto v = table_.find(b.variable)) w->out_vars.push_back(static_cast<int>(*v));
+        if (auto v = table_->find(b.variable)) w->out_vars.push_back(static_cast<int>(*v));
     workers_.push_back(std::move(w));
   }
 }
 
-void RealExecutive::link_workers(const ReleaseOrder& order) {
+void RealExecutive::link_workers() {
+  const ReleaseOrder& order = order_;
   // Whether aperiodic task `j` reads one of task `i`'s outputs: then `i` may trigger it.
   const auto reads_from = [&](const Worker& j, const Worker& i) {
     return std::ranges::any_of(j.task->resolved().bindings, [&](const PortBinding& b) {
-      const auto v = b.kind == PortKind::kInVar ? table_.find(b.variable) : std::nullopt;
+      const auto v = b.kind == PortKind::kInVar ? table_->find(b.variable) : std::nullopt;
       return v && std::ranges::find(i.out_vars, static_cast<int>(*v)) != i.out_vars.end();
     });
   };
@@ -165,7 +183,8 @@ void RealExecutive::make_dispatchers(const SchedulePlan& plan) {
   }
 }
 
-void RealExecutive::form_threads(const ReleaseOrder& order) {
+void RealExecutive::form_threads() {
+  const ReleaseOrder& order = order_;
   // Under rm and dm, periodic tasks of one CPU and one period share a priority, and SCHED_FIFO
   // would run their threads one after the other: one thread runs them, in data-flow order.
   // Everything else (aperiodic tasks, edf and muf's per-job priorities) has a thread of its own.
@@ -191,16 +210,32 @@ void RealExecutive::form_threads(const ReleaseOrder& order) {
   }
 }
 
-RealExecutive::~RealExecutive() {
+RealExecutive::~RealExecutive() { shutdown(); }
+
+void RealExecutive::shutdown() {
+  stop_serving();
+  if (stopped_at_ns_ >= 0) return;
+  // The paper's two-step termination: every task off, then every task killed.
+  for (std::size_t i = 0; i < workers_.size(); ++i)
+    if (tasks_[i]->state() == TaskState::kOn) (void)signal(i, Signal::kOff);
   for (std::size_t i = 0; i < workers_.size(); ++i) {
     Worker& w = *workers_[i];
     if (w.thread->running && w.task->state() != TaskState::kNotCreated) (void)signal(i, Signal::kKill);
   }
   for (auto& t : threads_)
     if (t->running) pthread_join(t->handle, nullptr);  // its last member's kill ended it
+  stopped_at_ns_ = monotonic_ns() - epoch_ns_;
+  // A hard job still overdue when the run stopped no longer holds the flag.
+  for (std::size_t i = 0; i < overdue_hold_.size(); ++i)
+    if (overdue_hold_[i]) table_->lower_illegal_configuration();
+  overdue_hold_.assign(overdue_hold_.size(), false);
 }
 
-std::int64_t RealExecutive::now_ns() const { return monotonic_ns() - epoch_ns_; }
+std::int64_t RealExecutive::now_ns() const { return stopped_at_ns_ >= 0 ? stopped_at_ns_ : monotonic_ns() - epoch_ns_; }
+
+void RealExecutive::run_for(std::int64_t ns) {
+  if (ns > 0) std::this_thread::sleep_for(std::chrono::nanoseconds(ns));
+}
 
 int RealExecutive::fixed_priority(std::size_t index) const { return workers_[index]->fixed_priority; }
 
@@ -239,7 +274,7 @@ Result<void> RealExecutive::start_thread(TaskThread& thread) const {
     pthread_attr_setinheritsched(&attr, PTHREAD_EXPLICIT_SCHED);
     pthread_attr_setschedpolicy(&attr, SCHED_FIFO);
     pthread_attr_setschedparam(&attr, &sp);
-    for (Worker* m : w.members) m->current_priority.store(w.priority, std::memory_order_relaxed);  // before it runs
+    for (Worker* m : w.members) m->job.current_priority.store(w.priority, std::memory_order_relaxed);  // before it runs
     rc = pthread_create(&w.handle, &attr, thread_entry, &w);
     if (rc == EPERM)
       warn_once(g_warned_fifo,
@@ -261,10 +296,10 @@ Result<void> RealExecutive::start_thread(TaskThread& thread) const {
 }
 
 std::uint32_t RealExecutive::send(Worker& w, const Mail& mail) {
-  w.mail = mail;
-  const std::uint32_t seq = w.request_seq.load(std::memory_order_relaxed) + 1;  // only this thread writes it
-  w.request_seq.store(seq, std::memory_order_release);                          // release: publishes `mail`
-  detail::futex_wake_all(w.request_seq);
+  w.mailbox.mail = mail;
+  const std::uint32_t seq = w.mailbox.request_seq.load(std::memory_order_relaxed) + 1;  // only this thread writes it
+  w.mailbox.request_seq.store(seq, std::memory_order_release);                          // release: publishes `mail`
+  detail::futex_wake_all(w.mailbox.request_seq);
   // The thread sleeps on its bell whatever it waits for (an aperiodic task on its eventfd).
   w.thread->bell.fetch_add(1, std::memory_order_release);  // release: the mail is seen after the wake
   detail::futex_wake_all(w.thread->bell);
@@ -275,14 +310,14 @@ std::uint32_t RealExecutive::send(Worker& w, const Mail& mail) {
 Result<void> RealExecutive::await(Worker& w, std::uint32_t seq) {
   const std::int64_t give_up = monotonic_ns() + kReplyTimeoutNs;
   for (;;) {
-    const std::uint32_t done = w.done_seq.load(std::memory_order_acquire);  // acquire: see `reply`
+    const std::uint32_t done = w.mailbox.done_seq.load(std::memory_order_acquire);  // acquire: see `reply`
     if (done == seq) break;
-    if (!detail::futex_wait(w.done_seq, done, give_up) && monotonic_ns() >= give_up)
+    if (!detail::futex_wait(w.mailbox.done_seq, done, give_up) && monotonic_ns() >= give_up)
       return make_error(Errc::kModuleFault,
                         fmt::format("{}: no answer within 10 s (a method is stuck?)", w.task->name()));
   }
-  Result<void> r = std::move(w.reply);
-  w.reply = Result<void>{};
+  Result<void> r = std::move(w.mailbox.reply);
+  w.mailbox.reply = Result<void>{};
   if (w.thread->exiting.load(std::memory_order_acquire)) {  // acquire: set before the answer
     pthread_join(w.thread->handle, nullptr);                // its last member was killed (or failed its init)
     w.thread->running = false;
@@ -304,6 +339,7 @@ Result<void> RealExecutive::post_all(const std::vector<std::size_t>& indices, co
 
 Result<void> RealExecutive::signal(std::size_t index, Signal sig) {
   std::lock_guard<std::mutex> lock(control_mutex_);
+  if (stopped_at_ns_ >= 0) return make_error(Errc::kState, "the subsystem is stopped");
   Worker& w = *workers_[index];
   if (!w.thread->running) {
     if (sig != Signal::kSpawn) return w.task->apply(sig, now_ns());  // refused by the state table
@@ -312,73 +348,19 @@ Result<void> RealExecutive::signal(std::size_t index, Signal sig) {
   return post(w, Mail{MailKind::kSignal, sig, 0});
 }
 
-Result<void> RealExecutive::turn_on_together(const std::vector<std::size_t>& indices, std::int64_t not_before_ns) {
+Result<void> RealExecutive::turn_on_together(const std::vector<std::size_t>& indices) {
   std::lock_guard<std::mutex> lock(control_mutex_);
-  return turn_on_locked(indices, not_before_ns);
-}
-
-Result<void> RealExecutive::commit_switch(const std::vector<std::size_t>& leaving,
-                                          const std::vector<std::size_t>& joining, std::int64_t commit_ns) {
-  std::lock_guard<std::mutex> lock(control_mutex_);
-  // Every leaving task answers once it is off: after its last release before the commit. Only
-  // then may a joining task turn on, since on() publishes outputs a leaving task wrote: one
-  // writer per variable at any time.
-  // Successors of the joining tasks must wait for them from the commit's release on, even if the
-  // commit runs late: tell them before anything changes.
-  for (const std::size_t i : joining) {
-    Worker& w = *workers_[i];
-    if (w.task->periodic())
-      w.joining_k.store((commit_ns + w.task->period_ns() - 1) / w.task->period_ns(), std::memory_order_release);
-  }
-  // The commit is timed to a cycle boundary: the control thread runs it at a real-time priority
-  // above the tasks', so that it is not the one that comes late.
-  const ScopedPriority urgent(realtime_, kCommitPriority);
-  const std::vector<Mail> leave(leaving.size(), Mail{MailKind::kLeaveAt, Signal::kOff, epoch_ns_ + commit_ns});
-  Result<void> r = post_all(leaving, leave);
-  // Each joining task turns on right before its first release from the commit on, on its own
-  // thread: not earlier, since on() publishes outputs a consumer may still be reading the leaving
-  // producer's last value of. Its first release is the commit's even if the commit ran late
-  // (then it runs late): the leaving task ran none from there, and no release may go unproduced.
-  // They are all posted at once and answer as each turns on.
-  std::vector<Mail> join;
-  for (const std::size_t i : joining) {
-    const Worker& w = *workers_[i];
-    const std::int64_t p = w.task->periodic() ? w.task->period_ns() : 1;
-    join.push_back(Mail{MailKind::kOnAt, Signal::kOn, (commit_ns + p - 1) / p});
-  }
-  if (auto on = post_all(joining, join); r && !on) r = on;
-  for (const std::size_t i : joining)
-    workers_[i]->joining_k.store(-1, std::memory_order_release);  // scheduled says it now
-  return r;
-}
-
-void RealExecutive::set_plan(const SchedulePlan& plan) {
-  std::lock_guard<std::mutex> lock(control_mutex_);
-  for (auto& d : dispatchers_) {
-    std::vector<TaskUrgency> urgency;
-    for (const Worker* w : d->workers()) urgency.push_back(plan.urgency[w->index]);
-    d->set_urgency(urgency);
-  }
-}
-
-Result<void> RealExecutive::reinit(std::size_t index) {
-  std::lock_guard<std::mutex> lock(control_mutex_);
-  return post(*workers_[index], Mail{MailKind::kReinit, Signal::kOn, 0});
-}
-
-Result<void> RealExecutive::turn_on_locked(const std::vector<std::size_t>& indices, std::int64_t not_before_ns) {
   for (const std::size_t i : indices)
     if (auto r = post(*workers_[i], Mail{MailKind::kOnHeld, Signal::kOn, 0}); !r) return r;
   // Every task is on and waits; now one instant for all: each task's first release is its first
   // grid point at or after it, published before any is let go (the same-rate rule reads it).
-  const std::int64_t instant = std::max(now_ns(), not_before_ns);
+  const std::int64_t instant = now_ns();
   std::vector<std::pair<std::size_t, std::int64_t>> joins;
   for (const std::size_t i : indices) {
     Worker& w = *workers_[i];
     if (!w.task->periodic() || w.task->state() != TaskState::kOn) continue;
-    const std::int64_t p = w.task->period_ns();
-    const std::int64_t k = (instant + p - 1) / p;
-    w.scheduled.store(k, std::memory_order_release);  // release: pairs with successors' acquire load
+    const std::int64_t k = release_policy::first_release_index(instant, w.task->period_ns());
+    w.precedence.scheduled.store(k, std::memory_order_release);  // release: pairs with successors' acquire load
     joins.emplace_back(i, k);
   }
   for (const auto& [i, k] : joins)
@@ -386,11 +368,75 @@ Result<void> RealExecutive::turn_on_locked(const std::vector<std::size_t>& indic
   return {};
 }
 
+Result<void> RealExecutive::commit_switch(const SwitchCommit& commit) {
+  const std::vector<std::size_t>& leaving = commit.leaving;
+  const std::vector<std::size_t>& joining = commit.joining;
+  SchedulePlan plan = make_schedule_plan(subsystem_, order_, subsystem_cpus(*subsystem_.spec), commit.target);
+  Result<void> r;
+  {
+    std::lock_guard<std::mutex> lock(control_mutex_);
+    // At the next boundary of the fastest task involved that leaves time to post the commit.
+    const std::int64_t shortest = shortest_period(tasks_, commit);
+    const std::int64_t now = now_ns();
+    const std::int64_t commit_ns =
+        shortest > 0 ? release_policy::next_boundary_after(now + kCommitMarginNs, shortest) : now;
+    // Every leaving task answers once it is off: after its last release before the commit. Only
+    // then may a joining task turn on, since on() publishes outputs a leaving task wrote: one
+    // writer per variable at any time.
+    // Successors of the joining tasks must wait for them from the commit's release on, even if
+    // the commit runs late: tell them before anything changes.
+    for (const std::size_t i : joining) {
+      Worker& w = *workers_[i];
+      if (w.task->periodic())
+        w.precedence.joining_k.store(release_policy::first_release_index(commit_ns, w.task->period_ns()),
+                                     std::memory_order_release);  // release: pairs with successors' acquire
+    }
+    // The commit is timed to a cycle boundary: the control thread runs it at a real-time priority
+    // above the tasks', so that it is not the one that comes late.
+    const ScopedPriority urgent(realtime_, kCommitPriority);
+    const std::vector<Mail> leave(leaving.size(), Mail{MailKind::kLeaveAt, Signal::kOff, epoch_ns_ + commit_ns});
+    r = post_all(leaving, leave);
+    // Each joining task turns on right before its first release from the commit on, on its own
+    // thread: not earlier, since on() publishes outputs a consumer may still be reading the
+    // leaving producer's last value of. Its first release is the commit's even if the commit ran
+    // late (then it runs late): the leaving task ran none from there, and no release may go
+    // unproduced. They are all posted at once and answer as each turns on.
+    std::vector<Mail> join;
+    for (const std::size_t i : joining) {
+      const Worker& w = *workers_[i];
+      const std::int64_t p = w.task->periodic() ? w.task->period_ns() : 1;
+      join.push_back(Mail{MailKind::kOnAt, Signal::kOn, release_policy::first_release_index(commit_ns, p)});
+    }
+    if (auto on = post_all(joining, join); r && !on) r = on;
+    for (const std::size_t i : joining)
+      workers_[i]->precedence.joining_k.store(-1, std::memory_order_release);  // scheduled says it now
+  }
+  set_plan(std::move(plan));
+  return r;
+}
+
+void RealExecutive::set_plan(SchedulePlan plan) {
+  std::lock_guard<std::mutex> lock(control_mutex_);
+  // Fixed priorities depend on periods and deadlines only and stay; the CPUs stay (the plan
+  // places every task of the file, whatever configuration is on).
+  for (auto& d : dispatchers_) {
+    std::vector<TaskUrgency> urgency;
+    for (const Worker* w : d->workers()) urgency.push_back(plan.urgency[w->index]);
+    d->set_urgency(urgency);
+  }
+  plan_ = std::move(plan);
+}
+
+Result<void> RealExecutive::reinit(std::size_t index) {
+  std::lock_guard<std::mutex> lock(control_mutex_);
+  return post(*workers_[index], Mail{MailKind::kReinit, Signal::kOn, 0});
+}
+
 void RealExecutive::variable_written(VarIndex v) {
   for (auto& w : workers_) {
-    if (w->trigger_var.load(std::memory_order_relaxed) != static_cast<int>(v)) continue;  // a hint, see below
+    if (w->wake.trigger_var.load(std::memory_order_relaxed) != static_cast<int>(v)) continue;  // a hint, see below
     // acq_rel: the value written happens before the cycle that clears the flag
-    if (!w->update_pending.exchange(true, std::memory_order_acq_rel)) ring_bell(*w);
+    if (!w->wake.update_pending.exchange(true, std::memory_order_acq_rel)) ring_bell(*w);
   }
 }
 

@@ -5,16 +5,18 @@
 // at absolute times epoch + k * period (no drift); aperiodic tasks wake on their trigger, within
 // their sporadic server's budget. Signals travel through a one-slot mailbox per task: the
 // control thread posts and waits; the task's thread carries the signal out between cycles and
-// never waits for the control thread.
+// never waits for the control thread. A service thread carries out the modules' switch requests
+// and watches for jobs running past their deadline (service_thread.cpp).
 
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <thread>
 #include <vector>
 
-#include "chimera/exec/task.hpp"
-#include "chimera/svt/global_table.hpp"
+#include "executive.hpp"
 #include "release_order.hpp"
 #include "schedule_plan.hpp"
 
@@ -25,69 +27,84 @@ struct TaskThread;
 struct Mail;
 class PriorityDispatcher;
 
-class RealExecutive {
+class RealExecutive final : public Executive {
  public:
-  RealExecutive(const std::vector<Task*>& tasks, const ReleaseOrder& order, const SchedulePlan& plan, bool realtime,
-                const GlobalTable& table);
-  ~RealExecutive();
+  explicit RealExecutive(ExecutiveSetup setup);
+  ~RealExecutive() override;
   RealExecutive(const RealExecutive&) = delete;
   RealExecutive& operator=(const RealExecutive&) = delete;
+  RealExecutive(RealExecutive&&) = delete;
+  RealExecutive& operator=(RealExecutive&&) = delete;
 
-  /// Time since the executive's epoch on CLOCK_MONOTONIC.
-  [[nodiscard]] std::int64_t now_ns() const;
-  [[nodiscard]] std::int64_t epoch_ns() const { return epoch_ns_; }
-  [[nodiscard]] const GlobalTable& table() const { return table_; }
-  /// Whether real-time priorities were asked for (they may still have been refused).
-  [[nodiscard]] bool realtime() const { return realtime_; }
-  /// Carries out a signal on the task's own thread (started by spawn, ended by kill) and
-  /// waits for it. Not real-time safe; never blocks a task's thread.
-  Result<void> signal(std::size_t index, Signal sig);
-  /// Turns on the tasks `indices` (OFF) as one: on() on each task's thread, then every one's
-  /// first release at its first grid point at or after one common instant, so that none runs a
-  /// release before all are on. Not real-time safe.
-  Result<void> turn_on_together(const std::vector<std::size_t>& indices, std::int64_t not_before_ns = 0);
-  /// A switch's commit (docs/reconfiguration.md): every task of `leaving` (ON) turns off after its
-  /// last release before `commit_ns` (subsystem clock); then every task of `joining` (OFF) turns
-  /// on, first released at its first grid point at or after `commit_ns` (later only if the
-  /// leaving took longer). The other tasks run on untouched. Not real-time safe.
-  Result<void> commit_switch(const std::vector<std::size_t>& leaving, const std::vector<std::size_t>& joining,
-                             std::int64_t commit_ns);
-  /// New urgency data (MUF's critical set after a switch) for the edf / muf dispatchers; fixed
-  /// priorities depend on periods and deadlines only and stay. Not real-time safe.
-  void set_plan(const SchedulePlan& plan);
-  /// reinit() on the task's own thread, between two of its cycles. Not real-time safe.
-  Result<void> reinit(std::size_t index);
-  /// Someone other than a task wrote variable `v` (the operator's `set`): wakes the aperiodic
-  /// tasks triggered by it. Not real-time safe.
-  void variable_written(VarIndex v);
-  /// The absolute deadline (executive clock) of the job task `index` is running now, if it is
+  // Executive.
+  [[nodiscard]] ClockKind clock() const noexcept override { return ClockKind::kReal; }
+  [[nodiscard]] std::int64_t now_ns() const override;
+  [[nodiscard]] int cpu_of(std::size_t task) const override { return cpus_[task]; }
+  Result<void> signal(std::size_t task, Signal sig) override;
+  Result<void> turn_on_together(const std::vector<std::size_t>& tasks) override;
+  Result<void> commit_switch(const SwitchCommit& commit) override;
+  Result<void> reinit(std::size_t task) override;
+  void run_for(std::int64_t ns) override;
+  void serve(ServiceHooks hooks) override;
+  void stop_serving() override;
+  void variable_written(VarIndex v) override;
+  void shutdown() override;
+
+  /// CLOCK_MONOTONIC at the executive's time 0. Real-time safe.
+  [[nodiscard]] std::int64_t epoch_ns() const noexcept { return epoch_ns_; }
+  [[nodiscard]] const GlobalTable& table() const { return *table_; }
+  /// The SCHED_FIFO priority task `task` starts at (its fixed priority under rm and dm).
+  [[nodiscard]] int fixed_priority(std::size_t task) const;
+  /// The absolute deadline (executive clock) of the job task `task` is running now, if it is
   /// running one with a deadline; it names the job. Any thread; wait-free.
-  [[nodiscard]] std::optional<std::int64_t> running_deadline(std::size_t index) const noexcept;
-  /// The SCHED_FIFO priority task `index` starts at (its fixed priority under rm and dm).
-  [[nodiscard]] int fixed_priority(std::size_t index) const;
+  [[nodiscard]] std::optional<std::int64_t> running_deadline(std::size_t task) const noexcept;
+
+  /// How often the service thread looks for jobs running past their deadline.
+  static constexpr std::int64_t kWatchTickNs = 5'000'000;
 
  private:
-  void make_workers(const std::vector<Task*>& tasks, const SchedulePlan& plan);
-  void link_workers(const ReleaseOrder& order);
+  void make_workers(const SchedulePlan& plan);
+  void link_workers();
   void make_dispatchers(const SchedulePlan& plan);
-  void form_threads(const ReleaseOrder& order);
+  void form_threads();
   Result<void> start_thread(TaskThread& thread) const;
-  /// Posts `mail` to a task's thread and waits for its answer. Not real-time safe.
+  /// Posts `mail` to a task's thread and waits for its answer.
   static Result<void> post(Worker& w, Mail mail);
   /// Posts `mail` to several tasks' threads at once, then waits for every answer.
   Result<void> post_all(const std::vector<std::size_t>& indices, const std::vector<Mail>& mails);
   /// Posts only; returns the sequence number of the answer to wait for.
   static std::uint32_t send(Worker& w, const Mail& mail);
   static Result<void> await(Worker& w, std::uint32_t seq);
-  Result<void> turn_on_locked(const std::vector<std::size_t>& indices, std::int64_t not_before_ns);
+  /// New urgency data (MUF's critical set after a switch) for the edf / muf dispatchers.
+  void set_plan(SchedulePlan plan);
+  /// The service thread's body, and one look at every task's running job (service_thread.cpp).
+  void service_main(ServiceHooks hooks);
+  void watch_overruns();
 
+  const ResolvedSubsystem& subsystem_;
+  GlobalTable* table_;
+  EventLog* events_;
+  std::vector<Task*> tasks_;
+  ReleaseOrder order_;
+  SchedulePlan plan_;
+  const std::vector<int> cpus_;  // plan_.cpu as it was made: a switch never moves a task, so any thread may read it
   std::vector<std::unique_ptr<PriorityDispatcher>> dispatchers_;  // outlive the workers that poke them
   std::vector<std::unique_ptr<Worker>> workers_;
   std::vector<std::unique_ptr<TaskThread>> threads_;
-  const GlobalTable& table_;
   std::int64_t epoch_ns_ = 0;
   bool realtime_ = false;
   std::mutex control_mutex_;  // one control request at a time; never taken by a task's thread
+
+  // The service thread (service_thread.cpp) and what its overrun watch holds.
+  std::thread service_;
+  std::atomic<bool> service_stop_{false};
+  Doorbell* service_bell_ = nullptr;  // what the service thread sleeps on: the requests' bell, or own_bell_
+  Doorbell own_bell_;
+  // Per task: the deadline of the job last reported overdue, and whether that job holds the
+  // illegal-configuration flag (a hard task's). The service thread's own.
+  std::vector<std::int64_t> overdue_reported_;
+  std::vector<bool> overdue_hold_;
+  std::int64_t stopped_at_ns_ = -1;  // after shutdown()
 };
 
 /// Asks for mlockall and reports, once per process, when real-time facilities are refused.

@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cstring>
 #include <optional>
 
@@ -11,6 +12,7 @@
 #include "futex.hpp"
 #include "priority_dispatcher.hpp"
 #include "real_executive.hpp"
+#include "release_policy.hpp"
 
 namespace chimera {
 
@@ -21,11 +23,11 @@ bool reached(std::uint32_t completed_plus_one, std::int64_t k) {
 }
 
 void set_own_priority(Worker& w, int priority) noexcept {
-  if (w.current_priority.load(std::memory_order_relaxed) == priority) return;
+  if (w.job.current_priority.load(std::memory_order_relaxed) == priority) return;
   sched_param sp{};
   sp.sched_priority = priority;
   if (pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp) == 0)
-    w.current_priority.store(priority, std::memory_order_relaxed);  // see PriorityDispatcher::rerank
+    w.job.current_priority.store(priority, std::memory_order_relaxed);  // see PriorityDispatcher::rerank
 }
 }  // namespace
 
@@ -40,48 +42,50 @@ void ring_bell(const Worker& w) noexcept {
 }
 
 bool Worker::take_mail() {
-  const std::uint32_t req = request_seq.load(std::memory_order_acquire);  // acquire: see `mail`
-  if (req == seen) return true;
-  seen = req;
+  const std::uint32_t req = mailbox.request_seq.load(std::memory_order_acquire);  // acquire: see `mail`
+  if (req == mailbox.seen) return true;
+  mailbox.seen = req;
   return handle(req);
 }
 
 void Worker::reply_to(std::uint32_t seq) {
-  done_seq.store(seq, std::memory_order_release);  // release: publishes `reply`
-  detail::futex_wake_all(done_seq);
+  mailbox.done_seq.store(seq, std::memory_order_release);  // release: publishes `reply`
+  detail::futex_wake_all(mailbox.done_seq);
 }
 
 bool Worker::handle(std::uint32_t seq) {
   const std::int64_t now = exec->now_ns();
   const TaskState before = task->state();
+  const Mail& mail = mailbox.mail;
   switch (mail.kind) {
     case MailKind::kJoin:
       // The control thread has already published `scheduled` for every task of the group.
-      k = mail.at;
-      held = false;
-      reply = Result<void>{};
+      schedule.k = mail.at;
+      schedule.held = false;
+      mailbox.reply = Result<void>{};
       reply_to(seq);
       return true;
     case MailKind::kLeaveAt:
-      leave_at = mail.at;
-      leave_seq = seq;
+      schedule.leave_at = mail.at;
+      schedule.leave_seq = seq;
       // Not released and nothing to finish: an aperiodic task, or one already past its last
       // release before the switch, leaves at once; otherwise after its current job (the loop).
-      if (!task->periodic() || task->state() != TaskState::kOn || exec->epoch_ns() + k * task->period_ns() >= leave_at)
+      if (!task->periodic() || task->state() != TaskState::kOn ||
+          exec->epoch_ns() + schedule.k * task->period_ns() >= schedule.leave_at)
         leave();
       return true;
     case MailKind::kReinit:
-      reply = task->reinit(now)
-                  ? Result<void>{}
-                  : make_error(Errc::kModuleFault, task->name() + ": reinit failed; the task is no longer ON");
+      mailbox.reply = task->reinit(now)
+                          ? Result<void>{}
+                          : make_error(Errc::kModuleFault, task->name() + ": reinit failed; the task is no longer ON");
       reply_to(seq);
       return task->state() != TaskState::kNotCreated;
     case MailKind::kOnAt:
       // Turned on at its first release, not now: on() publishes its outputs, and a consumer may
       // still be reading the leaving producer's last value of the release before.
       if (task->periodic() && task->state() == TaskState::kOff) {
-        on_at = mail.at;
-        on_seq = seq;
+        schedule.on_at = mail.at;
+        schedule.on_seq = seq;
         return true;
       }
       break;
@@ -93,15 +97,15 @@ bool Worker::handle(std::uint32_t seq) {
   // see that release as scheduled as soon as they can see the task ON, or one of them could run
   // its shared release without waiting for it: publish it before the state changes. (A held
   // task's release is published by the control thread before kJoin.)
-  const std::int64_t join = task->periodic() ? (now + task->period_ns() - 1) / task->period_ns() : -1;
+  const std::int64_t join = task->periodic() ? release_policy::first_release_index(now, task->period_ns()) : -1;
   const bool turning_on = before != TaskState::kOn && request == Signal::kOn;
   if (turning_on && task->periodic() && mail.kind == MailKind::kSignal)
-    scheduled.store(join, std::memory_order_release);  // release: pairs with successors' acquire load
-  reply = task->apply(request, now);
+    precedence.scheduled.store(join, std::memory_order_release);  // release: pairs with successors' acquire load
+  mailbox.reply = task->apply(request, now);
   if (before != TaskState::kOn && task->state() == TaskState::kOn) {
-    if (task->periodic()) k = join;
-    held = mail.kind == MailKind::kOnHeld && task->periodic();
-    leave_at = -1;
+    if (task->periodic()) schedule.k = join;
+    schedule.held = mail.kind == MailKind::kOnHeld && task->periodic();
+    schedule.leave_at = -1;
     on_turned_on();
   }
   const bool alive = task->state() != TaskState::kNotCreated;
@@ -115,45 +119,38 @@ bool Worker::handle(std::uint32_t seq) {
 }
 
 void Worker::join_now() {
-  const std::uint32_t seq = on_seq;
-  scheduled.store(on_at, std::memory_order_release);  // release: successors wait for this release
-  reply = task->apply(Signal::kOn, exec->now_ns());
+  const std::uint32_t seq = schedule.on_seq;
+  precedence.scheduled.store(schedule.on_at, std::memory_order_release);  // release: successors wait for it
+  mailbox.reply = task->apply(Signal::kOn, exec->now_ns());
   if (task->state() == TaskState::kOn) {
-    k = on_at;
+    schedule.k = schedule.on_at;
     on_turned_on();
   }
-  on_at = -1;
-  on_seq = 0;
+  schedule.on_at = -1;
+  schedule.on_seq = 0;
   reply_to(seq);
 }
 
 void Worker::leave() {
-  const std::uint32_t seq = leave_seq;
-  leave_at = -1;
-  leave_seq = 0;
-  reply = task->state() == TaskState::kOn ? task->apply(Signal::kOff, exec->now_ns()) : Result<void>{};
-  held = false;
+  const std::uint32_t seq = schedule.leave_seq;
+  schedule.leave_at = -1;
+  schedule.leave_seq = 0;
+  mailbox.reply = task->state() == TaskState::kOn ? task->apply(Signal::kOff, exec->now_ns()) : Result<void>{};
+  schedule.held = false;
   reply_to(seq);
 }
 
 void Worker::on_turned_on() noexcept {
-  int var = -1;
-  const std::string& port = task->trigger().update_port;
-  if (!port.empty()) {
-    for (const auto& b : task->resolved().bindings)
-      if (b.port == port)
-        if (auto v = exec->table().find(b.variable)) var = static_cast<int>(*v);
-  }
-  trigger_var.store(var, std::memory_order_relaxed);  // producers read it on its own
-  update_pending.store(false, std::memory_order_relaxed);
-  if (task->spec().server && refill_count == 0 && budget_ns <= 0) budget_ns = task->spec().server->budget_ns;
+  wake.trigger_var.store(task->trigger_var(), std::memory_order_relaxed);  // producers read it on its own
+  wake.update_pending.store(false, std::memory_order_relaxed);
+  if (task->spec().server) server.turn_on(task->spec().server->budget_ns);
 }
 
 void Worker::publish_job(std::int64_t release_abs) {
   const std::int64_t release = release_abs - exec->epoch_ns();
-  job_release_ns.store(release, std::memory_order_relaxed);
-  job_deadline_ns.store(task->absolute_deadline(release), std::memory_order_relaxed);
-  job_active.store(true, std::memory_order_release);  // release: the dispatcher sees the two above
+  job.release_ns.store(release, std::memory_order_relaxed);
+  job.deadline_ns.store(task->absolute_deadline(release), std::memory_order_relaxed);
+  job.active.store(true, std::memory_order_release);  // release: the dispatcher sees the two above
   dispatcher->poke();  // on this CPU the dispatcher preempts us here and sets our priority
 }
 
@@ -166,91 +163,77 @@ std::int64_t Worker::run_job(std::int64_t release_abs) {
   const std::int64_t used = task->end_job(monotonic_ns() - epoch, -1);
   running_deadline_ns.store(kNever, std::memory_order_relaxed);  // relaxed: as above
   for (Worker* s : subscribers) {
-    const int v = s->trigger_var.load(std::memory_order_relaxed);  // a hint; the flag below orders
+    const int v = s->wake.trigger_var.load(std::memory_order_relaxed);  // a hint; the flag below orders
     if (v < 0 || std::find(out_vars.begin(), out_vars.end(), v) == out_vars.end()) continue;
     // acq_rel: our published values happen before the subscriber's cycle that clears the flag
-    if (!s->update_pending.exchange(true, std::memory_order_acq_rel)) ring_bell(*s);
+    if (!s->wake.update_pending.exchange(true, std::memory_order_acq_rel)) ring_bell(*s);
   }
   if (dispatcher != nullptr) {
-    job_active.store(false, std::memory_order_relaxed);               // the dispatcher only ranks; order is not needed
+    job.active.store(false, std::memory_order_relaxed);               // the dispatcher only ranks; order is not needed
     set_own_priority(*this, PriorityDispatcher::kReleasingPriority);  // wake up able to ask for a rank
   }
   return used;
 }
 
 std::int64_t Worker::prepare() {
-  if (on_at >= 0) return exec->epoch_ns() + on_at * task->period_ns();  // a switch: on at that release
+  if (schedule.on_at >= 0) return exec->epoch_ns() + schedule.on_at * task->period_ns();  // a switch: on then
   if (task->state() != TaskState::kOn) {
-    scheduled.store(-1, std::memory_order_release);  // release: successors stop waiting on us
+    precedence.scheduled.store(-1, std::memory_order_release);  // release: successors stop waiting on us
     return kNever;
   }
-  if (held) return kNever;  // waiting for kJoin; `scheduled` is the control thread's until then
-  const std::int64_t release_abs = exec->epoch_ns() + k * task->period_ns();
-  if (leave_seq != 0 && release_abs >= leave_at) return 0;  // a switch: leave now
-  scheduled.store(k, std::memory_order_release);            // release: pairs with successors' acquire load
+  if (schedule.held) return kNever;  // waiting for kJoin; `scheduled` is the control thread's until then
+  const std::int64_t release_abs = exec->epoch_ns() + schedule.k * task->period_ns();
+  if (schedule.leave_seq != 0 && release_abs >= schedule.leave_at) return 0;  // a switch: leave now
+  precedence.scheduled.store(schedule.k, std::memory_order_release);          // release: pairs with successors' acquire
   return release_abs;
 }
 
 void Worker::act() {
   // A switch's joining task turns on and runs its first release at once: a consumer that shares
   // its thread comes after it in the same pass and must find that release done.
-  if (on_at >= 0) join_now();
-  if (task->state() != TaskState::kOn || held) return;
+  if (schedule.on_at >= 0) join_now();
+  if (task->state() != TaskState::kOn || schedule.held) return;
   const std::int64_t period = task->period_ns();
   const std::int64_t epoch = exec->epoch_ns();
-  std::int64_t release_abs = epoch + k * period;
-  if (leave_seq != 0 && release_abs >= leave_at) {
+  if (schedule.leave_seq != 0 && epoch + schedule.k * period >= schedule.leave_at) {
     leave();  // a switch: this task's last release came before the commit
     return;
   }
-  const std::int64_t now = monotonic_ns();
-  if (task->spec().late == LatePolicy::kSkip) {
-    // Releases whose deadline has already passed are not worth starting: skip them.
-    std::uint64_t skipped = 0;
-    while (task->absolute_deadline(release_abs - epoch) < now - epoch) {
-      ++k;
-      ++skipped;
-      release_abs += period;
-    }
-    if (skipped != 0) {
-      task->skip_releases(skipped, now - epoch);
-      scheduled.store(k, std::memory_order_release);  // release: as in prepare()
-      if (task->state() != TaskState::kOn || now < release_abs) return;
-    }
+  const std::int64_t now = monotonic_ns() - epoch;
+  const auto late =
+      release_policy::late_releases(task->spec().late, schedule.k * period, now, period, task->spec().deadline_ns);
+  if (late.skipped != 0) {
+    schedule.k += static_cast<std::int64_t>(late.skipped);
+    task->skip_releases(late.skipped, now);
+    precedence.scheduled.store(schedule.k, std::memory_order_release);  // release: as in prepare()
+    if (task->state() != TaskState::kOn || now < late.next_release) return;
   }
+  const std::int64_t release_abs = epoch + schedule.k * period;
   if (dispatcher != nullptr) publish_job(release_abs);
-  wait_for_predecessors(k, release_abs);
+  wait_for_predecessors(schedule.k, release_abs);
   (void)run_job(release_abs);
   // seq_cst store, then seq_cst load of `waiters`: with the successor's seq_cst increment and
   // re-check this is Dekker's pattern, so either it sees our store or we see it waiting.
-  completed.store(static_cast<std::uint32_t>(k + 1), std::memory_order_seq_cst);
-  if (waiters.load(std::memory_order_seq_cst) != 0) detail::futex_wake_all(completed);
-  ++k;  // under late: run a late cycle runs late; the next release stays on the absolute grid
-}
-
-void Worker::refill(std::int64_t now_abs) noexcept {
-  while (refill_count > 0 && refills[refill_head].first <= now_abs) {
-    budget_ns += refills[refill_head].second;
-    refill_head = (refill_head + 1) % kMaxRefills;
-    --refill_count;
-  }
+  precedence.completed.store(static_cast<std::uint32_t>(schedule.k + 1), std::memory_order_seq_cst);
+  if (precedence.waiters.load(std::memory_order_seq_cst) != 0) detail::futex_wake_all(precedence.completed);
+  ++schedule.k;  // under late: run a late cycle runs late; the next release stays on the absolute grid
 }
 
 void Worker::run_aperiodic() {
-  const std::uint32_t req = seen;
-  const std::optional<ServerSpec>& server = task->spec().server;
+  const std::uint32_t req = mailbox.seen;
+  const bool served = task->spec().server.has_value();
   const std::int64_t now = monotonic_ns();
-  refill(now);
-  const bool exhausted = server && budget_ns <= 0;
+  server.refill(now);
+  const bool exhausted = served && server.exhausted();
   const int fd = task->trigger().fd;
   std::array<pollfd, 2> fds{pollfd{bell_fd, POLLIN, 0}, pollfd{fd, POLLIN, 0}};
-  if (exhausted || !update_pending.load(std::memory_order_acquire)) {  // acquire: pairs with the producer
+  if (exhausted || !wake.update_pending.load(std::memory_order_acquire)) {  // acquire: pairs with the producer
     // An exhausted server waits for its next refill, and does not watch the event source meanwhile.
     const nfds_t n = (fd >= 0 && !exhausted) ? 2 : 1;
     timespec rel{};
     const timespec* timeout = nullptr;
-    if (exhausted && refill_count > 0) {
-      rel = to_timespec(std::max<std::int64_t>(0, refills[refill_head].first - now));
+    if (exhausted && server.pending() > 0) {
+      rel = to_timespec(std::max<std::int64_t>(0, server.next_refill() - now));
       timeout = &rel;
     }
     (void)::ppoll(fds.data(), n, timeout, nullptr);
@@ -259,50 +242,38 @@ void Worker::run_aperiodic() {
       [[maybe_unused]] const ssize_t got = ::read(bell_fd, &drained, sizeof(drained));  // only drains the counter
     }
   }
-  if (request_seq.load(std::memory_order_acquire) != req) return;  // the mail first; acquire: as in main
+  if (mailbox.request_seq.load(std::memory_order_acquire) != req) return;  // the mail first; acquire: as in main
   if (exhausted || task->state() != TaskState::kOn) return;
   const bool fd_event = fd >= 0 && (fds[1].revents & (POLLIN | POLLERR | POLLHUP)) != 0;
-  const bool update_event = update_pending.exchange(false, std::memory_order_acq_rel);  // acq_rel: see run_job
+  const bool update_event = wake.update_pending.exchange(false, std::memory_order_acq_rel);  // acq_rel: see run_job
   if (!fd_event && !update_event) return;
 
   const std::int64_t release_abs = monotonic_ns();
   if (dispatcher != nullptr) publish_job(release_abs);
   const std::int64_t start = monotonic_ns();
   const std::int64_t used = run_job(release_abs);
-  if (server) {
-    // Sporadic server: what a job used comes back one server period after the job started.
-    budget_ns -= used;
-    const auto refill_at = std::pair{start + server->period_ns, used};
-    if (refill_count < kMaxRefills) {
-      refills[(refill_head + refill_count) % kMaxRefills] = refill_at;
-      ++refill_count;
-    } else {
-      auto& last = refills[(refill_head + kMaxRefills - 1) % kMaxRefills];
-      last = {std::max(last.first, refill_at.first), last.second + used};  // merged, later: safe
-    }
-  }
+  if (served) server.charge(start, used, task->spec().server->period_ns);
 }
 
 void Worker::wait_for_predecessors(std::int64_t release, std::int64_t release_abs) const {
-  // Bounded: a predecessor that keeps us waiting more than half our deadline no longer holds us
-  // back. Counted from when the wait starts, so that the order still holds while tasks catch up
-  // after a stall (when every release is already in the past).
-  const std::int64_t give_up = std::max(release_abs, monotonic_ns()) + task->spec().deadline_ns / 2;
+  const std::int64_t give_up =
+      release_policy::producer_wait_until(release_abs, monotonic_ns(), task->spec().deadline_ns);
   for (Worker* p : predecessors) {
     for (;;) {
-      if (reached(p->completed.load(std::memory_order_acquire), release)) break;  // acquire: its cycle is done
-      const std::int64_t joins = p->joining_k.load(std::memory_order_acquire);    // acquire: pairs with the commit
+      // acquire: its cycle's outputs are published
+      const bool completed = reached(p->precedence.completed.load(std::memory_order_acquire), release);
+      const std::int64_t joins = p->precedence.joining_k.load(std::memory_order_acquire);  // acquire: the commit's
       const bool joining = joins >= 0 && joins <= release;
-      if (!joining) {
-        if (p->task->state() != TaskState::kOn) break;
-        const std::int64_t s = p->scheduled.load(std::memory_order_acquire);  // acquire: pairs with its store
-        if (s < 0 || s > release) break;  // not released, or joined after this instant
-      }
-      p->waiters.fetch_add(1, std::memory_order_seq_cst);  // seq_cst: Dekker with the producer (see act)
-      const std::uint32_t c = p->completed.load(std::memory_order_seq_cst);
+      // A joining producer is waited for at its first release as if it were ON already.
+      const bool on = joining || p->task->state() == TaskState::kOn;
+      // acquire: pairs with its store of the release it is about to run
+      const std::int64_t next = joining ? joins : p->precedence.scheduled.load(std::memory_order_acquire);
+      if (!release_policy::waits_for_producer(on, completed, next, release)) break;
+      p->precedence.waiters.fetch_add(1, std::memory_order_seq_cst);  // seq_cst: Dekker with the producer (see act)
+      const std::uint32_t c = p->precedence.completed.load(std::memory_order_seq_cst);
       bool in_time = true;
-      if (!reached(c, release)) in_time = detail::futex_wait(p->completed, c, give_up);
-      p->waiters.fetch_sub(1, std::memory_order_relaxed);  // only a hint for the producer's wake
+      if (!reached(c, release)) in_time = detail::futex_wait(p->precedence.completed, c, give_up);
+      p->precedence.waiters.fetch_sub(1, std::memory_order_relaxed);  // only a hint for the producer's wake
       if (!in_time && monotonic_ns() >= give_up) {
         task->record_order_timeout();
         return;  // past the bound: run with what the table holds

@@ -6,17 +6,21 @@
 // and so a priority: SCHED_FIFO would run such threads one after the other, never preempting
 // each other, so one thread running them in data-flow order behaves the same with one wake-up
 // instead of many. Private to the real executive.
+//
+// A Worker's state is grouped by who writes it: fixed at construction; the mailbox (control
+// thread in, task's thread out); what successors, the dispatcher, the overrun watch and
+// producers read of it (each group on its own cache line); and what only its thread touches.
 
 #include <pthread.h>
 #include <sched.h>
 
-#include <array>
 #include <atomic>
 #include <cstdint>
 #include <limits>
 #include <vector>
 
-#include "chimera/exec/task.hpp"
+#include "sporadic_server.hpp"
+#include "task.hpp"
 #include "urgency.hpp"
 
 namespace chimera {
@@ -61,6 +65,8 @@ struct Mail {
 };
 
 struct Worker {
+  static constexpr std::int64_t kNever = std::numeric_limits<std::int64_t>::max();
+
   // Fixed at construction (before any thread starts).
   RealExecutive* exec = nullptr;
   Task* task = nullptr;
@@ -74,57 +80,63 @@ struct Worker {
   int bell_fd = -1;                          // aperiodic: eventfd rung by signals and producers
   TaskThread* thread = nullptr;              // the thread that runs it
 
-  // Mailbox: written by the control thread, read by the task's thread.
-  alignas(64) std::atomic<std::uint32_t> request_seq{0};
-  Mail mail;
-  // Reply: written by the task's thread, read by the control thread.
-  alignas(64) std::atomic<std::uint32_t> done_seq{0};
-  Result<void> reply;
+  /// Requests from the control thread and the answers of the task's thread.
+  struct Mailbox {
+    alignas(64) std::atomic<std::uint32_t> request_seq{0};  // written by the control thread
+    Mail mail;
+    alignas(64) std::atomic<std::uint32_t> done_seq{0};  // written by the task's thread
+    Result<void> reply;
+    std::uint32_t seen = 0;  // the last mail handled; the task's thread's
+  } mailbox;
 
-  // Precedence: the last release completed (+1, modulo 2^32), and how many successors sleep on it.
-  alignas(64) std::atomic<std::uint32_t> completed{0};
-  std::atomic<std::uint32_t> waiters{0};
-  std::atomic<std::int64_t> scheduled{-1};  // release index about to run; -1 when not released
-  // A switch's commit: the release this (still OFF) task will join at; -1 when none. Successors
-  // wait for it at that release as if it were ON, so that a commit running late cannot make them
-  // read the leaving producer's last value.
-  std::atomic<std::int64_t> joining_k{-1};
+  /// What same-period successors read of it (the same-rate rule).
+  struct Precedence {
+    // The last release completed (+1, modulo 2^32), and how many successors sleep on it.
+    alignas(64) std::atomic<std::uint32_t> completed{0};
+    std::atomic<std::uint32_t> waiters{0};
+    std::atomic<std::int64_t> scheduled{-1};  // release index about to run; -1 when not released
+    // A switch's commit: the release this (still OFF) task will join at; -1 when none. Successors
+    // wait for it at that release as if it were ON, so that a commit running late cannot make them
+    // read the leaving producer's last value.
+    std::atomic<std::int64_t> joining_k{-1};
+  } precedence;
 
-  // The job it publishes for its dispatcher (edf / muf), and its own thread handle for it.
-  alignas(64) std::atomic<bool> job_active{false};
-  std::atomic<std::int64_t> job_release_ns{0};
-  std::atomic<std::int64_t> job_deadline_ns{0};
-  std::atomic<pthread_t> self{};
-  std::atomic<int> current_priority{0};  // what it runs at (set by itself or its dispatcher)
+  /// The job it publishes for its dispatcher (edf / muf), and its own thread handle for it.
+  struct DispatchedJob {
+    alignas(64) std::atomic<bool> active{false};
+    std::atomic<std::int64_t> release_ns{0};
+    std::atomic<std::int64_t> deadline_ns{0};
+    std::atomic<pthread_t> self{};
+    std::atomic<int> current_priority{0};  // what it runs at (set by itself or its dispatcher)
+  } job;
 
-  // The job it is running, for the overrun watch (exec/overrun_watch.cpp): its absolute deadline
-  // (executive clock), which names the job; kNever while no job runs.
-  alignas(64) std::atomic<std::int64_t> running_deadline_ns{std::numeric_limits<std::int64_t>::max()};
+  /// The job it is running, for the overrun watch (service_thread.cpp): its absolute deadline
+  /// (executive clock), which names the job; kNever while no job runs.
+  alignas(64) std::atomic<std::int64_t> running_deadline_ns{kNever};
 
-  // Aperiodic triggers: the variable it waits on (-1: none), and an update not yet served.
-  alignas(64) std::atomic<int> trigger_var{-1};
-  std::atomic<bool> update_pending{false};
+  /// Aperiodic triggers: the variable it waits on (-1: none), and an update not yet served.
+  struct Wake {
+    alignas(64) std::atomic<int> trigger_var{-1};
+    std::atomic<bool> update_pending{false};
+  } wake;
 
-  // Touched only by the task's thread.
-  std::uint32_t seen = 0;  // the last mail handled
-  std::int64_t k = 0;      // periodic: index of its next release on the grid
-  // Group starts and switches: touched only by the task's thread.
-  bool held = false;            // ON, but waiting for kJoin before its first release
-  std::int64_t leave_at = -1;   // absolute time: turn off before the first release at or after it
-  std::uint32_t leave_seq = 0;  // the kLeaveAt request to answer once off (0: none)
-  std::int64_t on_at = -1;      // kOnAt: the release index to turn on right before (-1: none)
-  std::uint32_t on_seq = 0;     // the kOnAt request to answer once on
-
-  // Sporadic server: touched only by the task's own thread.
-  static constexpr std::size_t kMaxRefills = 64;
-  std::int64_t budget_ns = 0;
-  std::array<std::pair<std::int64_t, std::int64_t>, kMaxRefills> refills{};  // (abs time, amount) ring
-  std::size_t refill_head = 0;
-  std::size_t refill_count = 0;
+  /// Touched only by the task's thread: its place on the grid, and a group start or a switch
+  /// it is in the middle of.
+  struct Schedule {
+    std::int64_t k = 0;           // periodic: index of its next release on the grid
+    bool held = false;            // ON, but waiting for kJoin before its first release
+    std::int64_t leave_at = -1;   // absolute time: turn off before the first release at or after it
+    std::uint32_t leave_seq = 0;  // the kLeaveAt request to answer once off (0: none)
+    std::int64_t on_at = -1;      // kOnAt: the release index to turn on right before (-1: none)
+    std::uint32_t on_seq = 0;     // the kOnAt request to answer once on
+  } schedule;
+  SporadicServer server;  // the task's thread's too
 
   Worker() = default;
   Worker(const Worker&) = delete;
   Worker& operator=(const Worker&) = delete;
+  Worker(Worker&&) = delete;
+  Worker& operator=(Worker&&) = delete;
   ~Worker();
 
   /// Handles the mail if there is new mail. Returns false when the task has just been destroyed
@@ -139,8 +151,6 @@ struct Worker {
   /// Aperiodic: waits for its trigger (or mail) and serves one event within its server's budget.
   void run_aperiodic();
 
-  static constexpr std::int64_t kNever = std::numeric_limits<std::int64_t>::max();
-
  private:
   bool handle(std::uint32_t seq);
   void reply_to(std::uint32_t seq);
@@ -152,7 +162,6 @@ struct Worker {
   /// Runs one job and tells successors and subscribers; returns the execution time it used.
   std::int64_t run_job(std::int64_t release_abs);
   void publish_job(std::int64_t release_abs);
-  void refill(std::int64_t now_abs) noexcept;
   void on_turned_on() noexcept;
 };
 

@@ -89,7 +89,7 @@ void TaskStats::record_skipped(std::uint64_t n) noexcept {
 
 void TaskStats::record_order_timeout() noexcept { bump(order_timeouts_); }
 
-TaskStatsSnapshot TaskStats::snapshot() const noexcept {
+TaskStatsSnapshot TaskStats::snapshot() const {
   TaskStatsSnapshot s;
   s.cycles = cycles_.load(std::memory_order_relaxed);  // figures may be one cycle apart: fine for a table
   s.missed = missed_.load(std::memory_order_relaxed);

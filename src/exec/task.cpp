@@ -1,4 +1,4 @@
-#include "chimera/exec/task.hpp"
+#include "task.hpp"
 
 #include <algorithm>
 #include <array>
@@ -180,13 +180,17 @@ void Task::timing_fault(Fault fault, std::int64_t now_ns) noexcept {
 }
 
 void Task::set_state(TaskState s) noexcept {
-  state_.store(s, std::memory_order_release);  // release: what the method did is visible to whoever sees the state
-  if (s == TaskState::kError) {
+  // Only the thread carrying out this task's methods changes its state, so `before` is current.
+  const TaskState before = state_.load(std::memory_order_relaxed);
+  // The paper's flag also marks an error in the subsystem, so that critical modules keep the
+  // system safe: a task in ERROR holds it, from before its state says ERROR until after it no
+  // longer does, so whoever sees the task in ERROR sees the flag up.
+  if (s == TaskState::kError && before != TaskState::kError) {
     ever_in_error_.store(true, std::memory_order_relaxed);  // a latch, read on its own
-    // The paper's flag also marks an error in the subsystem, so that critical modules keep the
-    // system safe; the subsystem interface lowers it once no task is in ERROR.
-    table_.set_illegal_configuration(true);
+    table_.raise_illegal_configuration();
   }
+  state_.store(s, std::memory_order_release);  // release: what the method did is visible to whoever sees the state
+  if (before == TaskState::kError && s != TaskState::kError) table_.lower_illegal_configuration();
 }
 
 Result<void> Task::apply(Signal signal, std::int64_t now_ns) {
@@ -250,6 +254,12 @@ Result<void> Task::spawn(std::int64_t now_ns) {
   }
   if (!periodic() && !trigger_.any())
     events_.push(now_ns, "aperiodic, and its module declared no trigger in init: it will never cycle", nullptr);
+  trigger_var_ = -1;
+  if (!trigger_.update_port.empty()) {
+    for (const auto& b : resolved_.bindings)
+      if (b.port == trigger_.update_port)
+        if (auto v = table_.find(b.variable)) trigger_var_ = static_cast<int>(*v);
+  }
   set_state(TaskState::kOff);
   return {};
 }

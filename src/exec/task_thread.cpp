@@ -12,7 +12,7 @@
 namespace chimera {
 
 void TaskThread::main() {
-  for (Worker* m : members) m->self.store(pthread_self(), std::memory_order_relaxed);  // see job_active
+  for (Worker* m : members) m->job.self.store(pthread_self(), std::memory_order_relaxed);  // see job.active
   // Touch the stack once so that its pages are resident before the first cycle.
   std::array<char, std::size_t{64} * 1024> prefault;  // NOLINT(cppcoreguidelines-pro-type-member-init): written next
   std::memset(prefault.data(), 0, prefault.size());

@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "chimera/svt/global_table.hpp"
+#include "release_policy.hpp"
 
 namespace chimera {
 
@@ -13,17 +14,24 @@ namespace {
 constexpr std::int64_t kNever = std::numeric_limits<std::int64_t>::max();
 }  // namespace
 
-VirtualExecutive::VirtualExecutive(std::vector<Task*> tasks, const ReleaseOrder& order, SchedulePlan plan,
-                                   const GlobalTable& table)
-    : tasks_(std::move(tasks)), order_(order), plan_(std::move(plan)), table_(table), slots_(tasks_.size()) {
+VirtualExecutive::VirtualExecutive(ExecutiveSetup setup)
+    : subsystem_(*setup.subsystem),
+      table_(*setup.table),
+      tasks_(std::move(setup.tasks)),
+      order_(compute_release_order(subsystem_)),
+      plan_(make_schedule_plan(subsystem_, order_, subsystem_cpus(*subsystem_.spec), setup.configuration)),
+      cpus_(plan_.cpu),
+      slots_(tasks_.size()) {
+  for (Task* t : tasks_) t->set_virtual_clock(true);
   std::vector<int> cpus;
   for (const int c : plan_.cpu)
     if (std::find(cpus.begin(), cpus.end(), c) == cpus.end()) cpus.push_back(c);
   running_.assign(cpus.size(), -1);
   for (const int c : plan_.cpu)
     cpu_slot_.push_back(static_cast<int>(std::find(cpus.begin(), cpus.end(), c) - cpus.begin()));
-  for (auto& s : slots_) s.server.refills.reserve(kMaxRefills);
 }
+
+VirtualExecutive::~VirtualExecutive() { shutdown(); }
 
 JobUrgency VirtualExecutive::urgency_of(std::size_t i) const {
   const std::int64_t r = slots_[i].job.release_ns;
@@ -37,9 +45,10 @@ bool VirtualExecutive::blocked_by_producer(std::size_t i) const {
   if (now_ns_ >= s.job.wait_until_ns) return false;
   return std::ranges::any_of(order_.predecessors[i], [&](int p) {
     const Slot& ps = slots_[static_cast<std::size_t>(p)];
-    if (tasks_[static_cast<std::size_t>(p)]->state() != TaskState::kOn) return false;
-    if (ps.first_release_ns > s.job.release_ns) return false;  // it joined after this release
-    return ps.last_done_release_ns < s.job.release_ns;
+    const bool on = tasks_[static_cast<std::size_t>(p)]->state() == TaskState::kOn;
+    const bool completed = ps.last_done_release_ns >= s.job.release_ns;
+    const std::int64_t next = ps.job.active ? ps.job.release_ns : ps.next_release_ns;  // what it runs next
+    return release_policy::waits_for_producer(on, completed, next, s.job.release_ns);
   });
 }
 
@@ -55,21 +64,19 @@ void VirtualExecutive::release_periodic(std::size_t i) {
   Slot& s = slots_[i];
   if (s.next_release_ns < 0 || s.job.active || s.next_release_ns > now_ns_) return;
   const std::int64_t period = t.period_ns();
-  if (t.spec().late == LatePolicy::kSkip) {
-    // Releases whose deadline has already passed are not worth starting: skip them.
-    std::uint64_t skipped = 0;
-    while (s.next_release_ns <= now_ns_ && t.absolute_deadline(s.next_release_ns) < now_ns_) {
-      s.next_release_ns += period;
-      ++skipped;
-    }
-    t.skip_releases(skipped, now_ns_);
+  const auto late =
+      release_policy::late_releases(t.spec().late, s.next_release_ns, now_ns_, period, t.spec().deadline_ns);
+  if (late.skipped != 0) {
+    s.next_release_ns = late.next_release;
+    t.skip_releases(late.skipped, now_ns_);
     if (t.state() != TaskState::kOn) {
       s.next_release_ns = -1;
       return;
     }
     if (s.next_release_ns > now_ns_) return;
   }
-  s.job = Job{true, false, s.next_release_ns, 0, 0, s.next_release_ns + t.spec().deadline_ns / 2};
+  const std::int64_t release = s.next_release_ns;
+  s.job = Job{true, false, release, 0, 0, release_policy::producer_wait_until(release, now_ns_, t.spec().deadline_ns)};
   s.next_release_ns += period;
 }
 
@@ -78,8 +85,8 @@ void VirtualExecutive::poll_triggers() {
     Task& t = *tasks_[i];
     Slot& s = slots_[i];
     if (t.periodic() || t.state() != TaskState::kOn) continue;
-    if (s.trigger_var >= 0) {
-      const std::uint64_t v = table_.version(static_cast<VarIndex>(s.trigger_var));
+    if (t.trigger_var() >= 0) {
+      const std::uint64_t v = table_.version(static_cast<VarIndex>(t.trigger_var()));
       if (v != s.seen_version) {
         s.seen_version = v;
         ++s.events;  // several writes at one instant are one event: the latest value is what counts
@@ -93,7 +100,7 @@ void VirtualExecutive::poll_triggers() {
         s.next_fd_poll_ns = now_ns_ + kPollPeriodNs;
     }
     const bool background = plan_.urgency[i].background;
-    if (s.events > 0 && !s.job.active && (background || s.server.budget_ns > 0)) {
+    if (s.events > 0 && !s.job.active && (background || !s.server.exhausted())) {
       --s.events;
       s.job = Job{true, false, now_ns_, 0, 0, now_ns_};
     }
@@ -101,12 +108,7 @@ void VirtualExecutive::poll_triggers() {
 }
 
 void VirtualExecutive::refill_servers() {
-  for (auto& s : slots_) {
-    auto& r = s.server.refills;
-    std::size_t done = 0;
-    while (done < r.size() && r[done].first <= now_ns_) s.server.budget_ns += r[done++].second;
-    r.erase(r.begin(), r.begin() + static_cast<std::ptrdiff_t>(done));  // no allocation: erasing only
-  }
+  for (auto& s : slots_) s.server.refill(now_ns_);
 }
 
 void VirtualExecutive::finish(std::size_t i) {
@@ -114,16 +116,7 @@ void VirtualExecutive::finish(std::size_t i) {
   Slot& s = slots_[i];
   t.end_job(now_ns_, s.job.exec_ns);
   s.last_done_release_ns = s.job.release_ns;
-  if (t.spec().server) {
-    // Sporadic server: what a job used comes back one server period after the job started.
-    auto& r = s.server.refills;
-    const std::int64_t at = s.job_start_ns + t.spec().server->period_ns;
-    if (r.size() < kMaxRefills)
-      r.emplace_back(at, s.job.exec_ns);
-    else
-      r.back() = {std::max(r.back().first, at), r.back().second + s.job.exec_ns};  // merged, later: safe
-    s.server.budget_ns -= s.job.exec_ns;
-  }
+  if (t.spec().server) s.server.charge(s.job_start_ns, s.job.exec_ns, t.spec().server->period_ns);
   s.job = Job{};
   s.next_fd_poll_ns = now_ns_;  // level-triggered: look again right away
   const int c = cpu_slot_[i];
@@ -177,7 +170,7 @@ std::int64_t VirtualExecutive::next_event_after_dispatch() const {
     const Task& task = *tasks_[i];
     if (!s.job.active && s.next_release_ns >= 0) t = std::min(t, s.next_release_ns);
     if (s.job.active && !s.job.started && s.job.wait_until_ns > now_ns_) t = std::min(t, s.job.wait_until_ns);
-    if (!s.server.refills.empty()) t = std::min(t, s.server.refills.front().first);
+    t = std::min(t, s.server.next_refill());
     const bool watching = !task.periodic() && task.state() == TaskState::kOn && task.trigger().fd >= 0;
     if (watching && !s.job.active && s.events == 0) t = std::min(t, std::max(s.next_fd_poll_ns, now_ns_ + 1));
   }
@@ -204,17 +197,26 @@ void VirtualExecutive::step() {
   dispatch();
 }
 
-bool VirtualExecutive::run_until(std::int64_t end_ns, const std::atomic<std::uint32_t>* watch) {
-  const std::uint32_t seen = watch != nullptr ? watch->load(std::memory_order_acquire) : 0;  // acquire: the request
+bool VirtualExecutive::run_until(std::int64_t end_ns, const Doorbell* watch) {
+  const std::uint32_t seen = watch != nullptr ? watch->rung() : 0;
   for (;;) {
     step();
-    if (watch != nullptr && watch->load(std::memory_order_acquire) != seen) return false;  // acquire: as above
+    if (watch != nullptr && watch->rung() != seen) return false;
     const std::int64_t t = next_event_after_dispatch();
     if (t >= end_ns) break;
     advance_to(t);
   }
   if (end_ns > now_ns_) advance_to(end_ns);
   return true;
+}
+
+void VirtualExecutive::run_for(std::int64_t ns) {
+  if (ns <= 0 || stopped_) return;
+  const std::int64_t end = now_ns_ + ns;
+  // A task that asks for a switch stops the simulation at that instant; the switch happens
+  // there, and the run goes on: the same file and inputs give the same trace.
+  while (!run_until(end, hooks_.requests))
+    if (hooks_.serve_requests) hooks_.serve_requests();
 }
 
 Result<void> VirtualExecutive::reinit(std::size_t task) {
@@ -232,6 +234,7 @@ void VirtualExecutive::end_open_job(std::size_t i) {
 }
 
 Result<void> VirtualExecutive::signal(std::size_t task, Signal signal) {
+  if (stopped_) return make_error(Errc::kState, "the subsystem is stopped");
   Task& t = *tasks_[task];
   Slot& s = slots_[task];
   end_open_job(task);
@@ -247,23 +250,45 @@ Result<void> VirtualExecutive::signal(std::size_t task, Signal signal) {
     // has already run it.
     const std::int64_t p = t.period_ns();
     const std::int64_t from = now_ns_ == stepped_ns_ ? now_ns_ + 1 : now_ns_;
-    s.next_release_ns = (from + p - 1) / p * p;
-    s.first_release_ns = s.next_release_ns;
+    s.next_release_ns = release_policy::first_release_index(from, p) * p;
     s.last_done_release_ns = -1;
   }
   if (!t.periodic()) {
-    s.trigger_var = -1;
-    if (!t.trigger().update_port.empty()) {
-      for (const auto& b : t.resolved().bindings)
-        if (b.port == t.trigger().update_port)
-          if (auto v = table_.find(b.variable)) s.trigger_var = static_cast<int>(*v);
-      if (s.trigger_var >= 0) s.seen_version = table_.version(static_cast<VarIndex>(s.trigger_var));
-    }
-    if (t.spec().server && s.server.refills.empty() && s.server.budget_ns <= 0)
-      s.server.budget_ns = t.spec().server->budget_ns;
+    if (t.trigger_var() >= 0) s.seen_version = table_.version(static_cast<VarIndex>(t.trigger_var()));
+    if (t.spec().server) s.server.turn_on(t.spec().server->budget_ns);
     s.next_fd_poll_ns = now_ns_;
   }
   return r;
+}
+
+Result<void> VirtualExecutive::turn_on_together(const std::vector<std::size_t>& tasks) {
+  for (const std::size_t i : tasks)
+    if (auto r = signal(i, Signal::kOn); !r) return r;
+  return {};
+}
+
+Result<void> VirtualExecutive::commit_switch(const SwitchCommit& commit) {
+  // Creating tasks takes no simulated time, but a switch that must create them is one that takes
+  // longer than a cycle: the old configuration runs on, flag raised, until the next boundary of
+  // the fastest task involved.
+  const std::int64_t shortest = shortest_period(tasks_, commit);
+  if (commit.slow && shortest > 0) (void)run_until(release_policy::next_boundary_after(now_ns_, shortest));
+  Result<void> committed;
+  for (const std::size_t i : commit.leaving) (void)signal(i, Signal::kOff);
+  for (const std::size_t i : commit.joining)
+    if (auto r = signal(i, Signal::kOn); !r && committed) committed = r;
+  plan_ = make_schedule_plan(subsystem_, order_, subsystem_cpus(*subsystem_.spec), commit.target);
+  return committed;
+}
+
+void VirtualExecutive::shutdown() {
+  if (stopped_) return;
+  // The paper's two-step termination: every task off, then every task killed.
+  for (std::size_t i = 0; i < tasks_.size(); ++i)
+    if (tasks_[i]->state() == TaskState::kOn) (void)signal(i, Signal::kOff);
+  for (std::size_t i = 0; i < tasks_.size(); ++i)
+    if (tasks_[i]->state() != TaskState::kNotCreated) (void)signal(i, Signal::kKill);
+  stopped_ = true;
 }
 
 }  // namespace chimera

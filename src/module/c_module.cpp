@@ -4,7 +4,11 @@
 
 #include "chimera/module/c_module.h"
 
+#include <dlfcn.h>
+
+#include <array>
 #include <cstddef>
+#include <cstring>
 #include <deque>
 #include <memory>
 #include <string>
@@ -13,6 +17,7 @@
 
 #include <fmt/format.h>
 
+#include "chimera/core/identifier.hpp"
 #include "chimera/module/registry.hpp"
 
 struct chimera_decl {
@@ -52,6 +57,66 @@ std::string text_or_empty(const char* s) { return s != nullptr ? std::string(s) 
 chimera::Dim dim_of(chimera_dim d) { return chimera::Dim{d.factor, text_or_empty(d.symbol), d.follows != 0}; }
 
 Status status_of(chimera_status s) { return s == CHIMERA_OK ? Status::ok() : Status::fail(s); }
+
+/// More per-task state than any module needs: a state_size past it is a struct of another shape
+/// (its next field, a code address, read as a size).
+constexpr std::size_t kMaxStateBytes = std::size_t{16} << 20;
+constexpr std::size_t kMaxNameBytes = 64;
+
+/// The base address of the loaded object that `p` points into, or nullptr if none does.
+const void* object_of(const void* p) {
+  Dl_info info{};
+  if (p == nullptr || ::dladdr(p, &info) == 0) return nullptr;
+  return info.dli_fbase;
+}
+
+// NOLINTNEXTLINE(cppcoreguidelines-pro-type-reinterpret-cast): a function's address, for dladdr only
+template <class F>
+const void* address_of(F* f) {
+  return reinterpret_cast<const void*>(f);
+}
+
+/// Whether `text` points into a loaded object and ends within `max` bytes (it is read only then).
+bool readable_text(const char* text, std::size_t max) {
+  return object_of(text) != nullptr && ::strnlen(text, max) < max;
+}
+
+/// What is wrong with a struct whose version matches, before any of its functions is called or
+/// its strings read: "" if nothing.
+std::string struct_problem(const chimera_c_module& m) {
+  if (m.struct_size != sizeof(chimera_c_module))
+    return fmt::format("its struct is {} bytes, this chimera's is {}", m.struct_size, sizeof(chimera_c_module));
+  const void* home = object_of(&m);
+  if (m.name == nullptr) return "it has no name";
+  if (!readable_text(m.name, kMaxNameBytes) || !chimera::is_identifier(m.name))
+    return "its name is not a valid module name";
+  for (const char* text : {m.summary, m.doc})
+    if (text != nullptr && object_of(text) == nullptr) return "its summary or doc is not a string of the library";
+  if (m.state_size > kMaxStateBytes)
+    return fmt::format("its state_size is {} bytes, more than {} MiB", m.state_size, kMaxStateBytes >> 20U);
+  if (m.declare == nullptr) return "it has no declare function";
+  if (object_of(address_of(m.declare)) != home) return "its declare is not a function of the library";
+  const std::array<std::pair<const char*, const void*>, 9> methods{{{"init", address_of(m.init)},
+                                                                    {"on", address_of(m.on)},
+                                                                    {"cycle", address_of(m.cycle)},
+                                                                    {"off", address_of(m.off)},
+                                                                    {"kill", address_of(m.kill)},
+                                                                    {"error", address_of(m.error)},
+                                                                    {"clear", address_of(m.clear)},
+                                                                    {"reinit", address_of(m.reinit)},
+                                                                    {"sync", address_of(m.sync)}}};
+  for (const auto& [method, address] : methods)
+    if (address != nullptr && object_of(address) != home)
+      return fmt::format("its {} is not a function of the library", method);
+  return {};
+}
+
+/// The module's name for a message about it: only if it is safe to read.
+std::string name_for_message(const chimera_c_module& m) {
+  if (m.struct_size == sizeof(chimera_c_module) && m.name != nullptr && readable_text(m.name, kMaxNameBytes))
+    return fmt::format("'{}'", m.name);
+  return "(name unreadable)";
+}
 
 class CModule final : public chimera::Module {
  public:
@@ -187,17 +252,18 @@ void chimera_register_c_module(const chimera_c_module* module) {
     registry.refuse("chimera_register_c_module was given NULL");
     return;
   }
-  const std::string name = text_or_empty(module->name);
   if (module->abi_version != CHIMERA_C_ABI_VERSION) {
-    // Only the first two fields are read: they keep their place in every version.
-    registry.refuse(fmt::format("C module '{}' was built for C ABI version {}, but this chimera has version {}", name,
+    // Only the first field is read: it keeps its place in every version.
+    registry.refuse(fmt::format("a C module was built for C ABI version {}, but this chimera has version {}",
                                 module->abi_version, CHIMERA_C_ABI_VERSION));
     return;
   }
-  if (name.empty() || module->declare == nullptr) {
-    registry.refuse(fmt::format("C module '{}' has no {}", name, name.empty() ? "name" : "declare function"));
+  if (const std::string problem = struct_problem(*module); !problem.empty()) {
+    registry.refuse(fmt::format("C module {}: {} (was it built against another chimera/module/c_module.h?)",
+                                name_for_message(*module), problem));
     return;
   }
+  const std::string name = module->name;
   const chimera_c_module* def = module;
   (void)registry.add(
       chimera::ModuleInfo{name, text_or_empty(module->summary), text_or_empty(module->doc),

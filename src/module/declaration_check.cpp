@@ -1,4 +1,4 @@
-#include "module/detail/declaration_check.hpp"
+#include "detail/declaration_check.hpp"
 
 #include <algorithm>
 #include <exception>
@@ -7,12 +7,10 @@
 
 #include <fmt/format.h>
 
-#include "config/detail/yaml_reader.hpp"
+#include "chimera/core/identifier.hpp"
 
 namespace chimera::module_detail {
 namespace {
-
-using config_detail::is_identifier;
 
 template <class Decl>
 bool declared_twice(const std::vector<Decl>& decls, std::size_t i) {

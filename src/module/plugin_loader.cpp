@@ -12,7 +12,7 @@
 #include <fmt/ranges.h>
 
 #include "chimera/module/registry.hpp"
-#include "module/detail/declaration_check.hpp"
+#include "detail/declaration_check.hpp"
 
 namespace chimera {
 namespace {

@@ -5,6 +5,27 @@
 
 #include <fmt/format.h>
 
+extern "C" void chimera_register_cxx_module(const chimera_cxx_abi_stamp* stamp, const char* module, void (*add)()) {
+  chimera::Registry& registry = chimera::Registry::global();
+  const std::string_view name = module != nullptr ? std::string_view(module) : std::string_view("?");
+  if (stamp == nullptr || stamp->magic != chimera::kCxxAbiStampMagic) {
+    registry.refuse(
+        fmt::format("module {} carries no ABI stamp: it was not built with this Chimera's "
+                    "CHIMERA_REGISTER_MODULE; rebuild it against Chimera {}",
+                    name, chimera::kChimeraVersion));
+    return;
+  }
+  if (stamp->fingerprint != chimera::kModuleAbiFingerprint) {
+    registry.refuse(
+        fmt::format("module {} was built for Chimera {} (module ABI {:016x}), but this is Chimera {} "
+                    "(module ABI {:016x}): rebuild the library against this version",
+                    name, stamp->version != nullptr ? stamp->version : "?", stamp->fingerprint,
+                    chimera::kChimeraVersion, chimera::kModuleAbiFingerprint));
+    return;
+  }
+  add();
+}
+
 namespace chimera {
 
 Registry& Registry::global() {

@@ -1,7 +1,5 @@
 #include "request_board.hpp"
 
-#include "exec/futex.hpp"
-
 namespace chimera {
 
 SubsystemRequestBoard::SubsystemRequestBoard(std::vector<std::string> configurations, std::size_t tasks)
@@ -21,8 +19,7 @@ void SubsystemRequestBoard::post(int task, int configuration) noexcept {
   // for the same thing costs one exchange and no system call.
   if (slots_[static_cast<std::size_t>(task)].exchange(configuration, std::memory_order_acq_rel) == configuration)
     return;
-  changes_.fetch_add(1, std::memory_order_release);  // release: pairs with the watchers' acquire
-  detail::futex_wake_all(changes_);
+  bell_.ring();
 }
 
 int SubsystemRequestBoard::asked(std::size_t task) const noexcept {
@@ -31,11 +28,6 @@ int SubsystemRequestBoard::asked(std::size_t task) const noexcept {
 
 void SubsystemRequestBoard::clear() noexcept {
   for (auto& slot : slots_) slot.store(-1, std::memory_order_relaxed);  // only hints until the next post
-}
-
-void SubsystemRequestBoard::wake() noexcept {
-  changes_.fetch_add(1, std::memory_order_release);  // release: the watcher re-reads its stop flag
-  detail::futex_wake_all(changes_);
 }
 
 }  // namespace chimera

@@ -23,7 +23,7 @@
 
 #include <fmt/format.h>
 
-#include "svt/shm_layout.hpp"
+#include "chimera/svt/detail/shm_layout.hpp"
 
 namespace chimera {
 
@@ -227,6 +227,7 @@ Result<GlobalTable> GlobalTable::create(std::string_view subsystem_name, std::sp
   // window in which this region has no owner is as short as possible.
   Word(header->owner_pid).store(static_cast<std::uint64_t>(::getpid()), std::memory_order_relaxed);
   header->layout_version = svt_detail::kLayoutVersion;
+  header->layout_fingerprint = svt_detail::kLayoutFingerprint;
   header->var_count = static_cast<std::uint32_t>(vars.size());
   header->directory_offset = svt_detail::directory_offset();
   header->total_size = total;
@@ -278,9 +279,12 @@ Result<GlobalTable> GlobalTable::attach(std::string_view subsystem_name) {
                                                  "still being created)",
                                                  shm));
   }
-  if (header->layout_version != svt_detail::kLayoutVersion) {
-    return make_error(Errc::kSystem, fmt::format("shared memory {} has layout version {}; this program "
-                                                 "understands version {}",
+  // The version word first: it is where every layout has kept it, so a region of an older layout
+  // is told apart without reading past what it has.
+  if (header->layout_version != svt_detail::kLayoutVersion ||
+      header->layout_fingerprint != svt_detail::kLayoutFingerprint) {
+    return make_error(Errc::kSystem, fmt::format("shared memory {} was made by another version of Chimera (layout "
+                                                 "{:08x}); this program understands layout {:08x}",
                                                  shm, header->layout_version, svt_detail::kLayoutVersion));
   }
   if (auto r = check_layout(table.base_, size, shm); !r) return r.error();

@@ -1,4 +1,4 @@
-// GlobalTable's split write, the reads registers cannot hold, and the flag: the protocol of
+// GlobalTable's split write (for tests), the reads registers cannot hold, and the flag: the protocol of
 // detail/seq_protocol.hpp applied to one variable's block (blocks_). The hot read and write are
 // inline: detail/global_table.inl.
 
@@ -8,7 +8,6 @@
 
 #include "chimera/svt/detail/seq_protocol.hpp"
 #include "chimera/svt/global_table.hpp"
-#include "svt/shm_layout.hpp"
 
 namespace chimera {
 
@@ -85,17 +84,27 @@ ReadOutcome GlobalTable::read_out_of_line(VarIndex v, void* dst, std::uint64_t s
   return read_block(b, dst, seen, nullptr);
 }
 
-void GlobalTable::set_illegal_configuration(bool raised) noexcept {
+void GlobalTable::raise_illegal_configuration() noexcept {
   auto* header = d::object_at<d::Header>(base_, 0);
-  // Release: what the raising task recorded before raising (its reason, its outputs) is visible
-  // to every task that sees the flag through the acquire load below.
-  d::Word(header->illegal_configuration).store(raised ? 1 : 0, std::memory_order_release);
+  // Release: what the raiser recorded before raising (its reason, its outputs) is visible to
+  // every task that sees the flag up through the acquire load below. An atomic increment, so no
+  // interleaving of raisers and lowerers loses a hold.
+  d::Word(header->illegal_configuration).fetch_add(1, std::memory_order_release);
 }
 
-bool GlobalTable::illegal_configuration() const noexcept {
+void GlobalTable::lower_illegal_configuration() noexcept {
   auto* header = d::object_at<d::Header>(base_, 0);
-  // Acquire: pairs with the release store above.
-  return d::Word(header->illegal_configuration).load(std::memory_order_acquire) != 0;
+  // Release: as for raising; a task that sees the flag down also sees why it went down.
+  const std::uint64_t before = d::Word(header->illegal_configuration).fetch_sub(1, std::memory_order_release);
+  CHIMERA_INVARIANT(before != 0, "the illegal-configuration flag lowered more often than raised");
+}
+
+bool GlobalTable::illegal_configuration() const noexcept { return illegal_configuration_holds() != 0; }
+
+std::uint64_t GlobalTable::illegal_configuration_holds() const noexcept {
+  auto* header = d::object_at<d::Header>(base_, 0);
+  // Acquire: pairs with the release increments and decrements above.
+  return d::Word(header->illegal_configuration).load(std::memory_order_acquire);
 }
 
 }  // namespace chimera

@@ -75,6 +75,21 @@ Result<const LocalTable::Slot*> LocalTable::find_slot(std::string_view port, boo
   return make_error(Errc::kNotFound, fmt::format("port '{}' does not exist", port));
 }
 
+PortWindow LocalTable::bind(std::string_view port, bool input, ElemType type, std::string& error) {
+  auto slot = find_slot(port, input, type);
+  if (!slot) {
+    error = slot.error().message;
+    return {};
+  }
+  const Slot* s = *slot;
+  const auto index = static_cast<std::size_t>(s - slots_.data());
+  // Storage is raw max-aligned bytes; each port's offset is 8-aligned, so any element type is
+  // aligned there.
+  // NOLINTNEXTLINE(cppcoreguidelines-pro-type-reinterpret-cast): see above
+  auto* bytes = reinterpret_cast<std::byte*>(storage_.data()) + s->offset;
+  return PortWindow{bytes, s->bytes / elem_size(type), input ? &freshness_[index] : nullptr};
+}
+
 void LocalTable::pull(PortKind kind) noexcept {
   // NOLINTNEXTLINE(cppcoreguidelines-pro-type-reinterpret-cast): storage_ is raw max-aligned bytes
   auto* base = reinterpret_cast<std::byte*>(storage_.data());

@@ -15,7 +15,8 @@
 #include <gtest/gtest.h>
 
 #include "chimera/config/loader.hpp"
-#include "chimera/exec/subsystem.hpp"
+#include "chimera/control/subsystem.hpp"
+#include "control/subsystem_test_access.hpp"
 #include "support/allocation_guard.hpp"
 #include "support/probe_module.hpp"
 #include "support/udp_sender.hpp"
@@ -261,14 +262,14 @@ TEST(NoAllocationInCycle, Figure3JoinOfTwoCameras) {
 TEST(NoAllocationInCycle, BothRobotInterfacesHoldingForAnIllegalConfiguration) {
   auto s = example("visual_servo.yaml", "standard");
   ASSERT_NE(s, nullptr);
-  s->table().set_illegal_configuration(true);  // robot_position holds
+  SubsystemTestAccess::table(*s).raise_illegal_configuration();  // robot_position holds
   expect_no_allocation(*s, 500 * kMs);
-  s->table().set_illegal_configuration(false);
+  SubsystemTestAccess::table(*s).lower_illegal_configuration();
   expect_no_allocation(*s, 500 * kMs);  // and lets go
   auto f4 = fig4(ClockKind::kVirtual);
-  f4->table().set_illegal_configuration(true);  // robot_torque holds
+  SubsystemTestAccess::table(*f4).raise_illegal_configuration();  // robot_torque holds
   expect_no_allocation(*f4, 500 * kMs);
-  f4->table().set_illegal_configuration(false);
+  SubsystemTestAccess::table(*f4).lower_illegal_configuration();
   expect_no_allocation(*f4, 500 * kMs);
 }
 

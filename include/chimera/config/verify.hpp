@@ -13,7 +13,7 @@
 #include "chimera/module/declarations.hpp"
 #include "chimera/module/registry.hpp"
 #include "chimera/svt/elem_type.hpp"
-#include "chimera/svt/local_table.hpp"
+#include "chimera/svt/port_binding.hpp"
 
 namespace chimera {
 

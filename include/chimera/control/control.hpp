@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "chimera/control/command.hpp"
-#include "chimera/exec/subsystem.hpp"
+#include "chimera/control/subsystem.hpp"
 #include "chimera/lifecycle/state.hpp"
 
 namespace chimera {

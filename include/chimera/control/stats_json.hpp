@@ -6,8 +6,8 @@
 #include <span>
 #include <string>
 
+#include "chimera/control/subsystem.hpp"
 #include "chimera/core/result.hpp"
-#include "chimera/exec/subsystem.hpp"
 
 namespace chimera {
 

@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "chimera/exec/subsystem.hpp"
+#include "chimera/control/subsystem.hpp"
 
 namespace chimera {
 

@@ -6,14 +6,9 @@
 #include <span>
 #include <string>
 
-#include "chimera/exec/subsystem.hpp"
+#include "chimera/control/subsystem.hpp"
 
 namespace chimera {
-
-/// "850 ns", "12.3 µs", "1.25 ms", "2.000 s": the unit that keeps the number short.
-std::string format_duration(std::int64_t ns);
-/// A period as it would be written in the file: "1 ms", "250 µs", "33.333 ms"; "aperiodic" for 0.
-std::string format_period(std::int64_t ns);
 
 /// Columns task, module, state, period, cycles, missed (and the last error when a task has one).
 /// Lines end in '\n'. Not real-time safe.

@@ -1,10 +1,13 @@
 #pragma once
-// Result types for fallible calls off the real-time path, and Status for module methods.
+// Result types for fallible calls off the real-time path, and Status for module methods. Asking a
+// Result for the value of an error, or for the error of a success, is a broken invariant
+// (chimera/core/invariant.hpp): it aborts with a message in every build type.
 
-#include <cassert>
 #include <string>
 #include <utility>
 #include <variant>
+
+#include "chimera/core/invariant.hpp"
 
 namespace chimera {
 
@@ -35,15 +38,15 @@ class [[nodiscard]] Result {
   explicit operator bool() const { return ok(); }
 
   T& value() & {
-    assert(ok());
+    CHIMERA_INVARIANT(ok(), "Result::value() of an error");
     return std::get<0>(v_);
   }
   const T& value() const& {
-    assert(ok());
+    CHIMERA_INVARIANT(ok(), "Result::value() of an error");
     return std::get<0>(v_);
   }
   T&& value() && {
-    assert(ok());
+    CHIMERA_INVARIANT(ok(), "Result::value() of an error");
     return std::get<0>(std::move(v_));
   }
   T* operator->() { return &value(); }
@@ -52,7 +55,7 @@ class [[nodiscard]] Result {
   const T& operator*() const& { return value(); }
 
   [[nodiscard]] const Error& error() const {
-    assert(!ok());
+    CHIMERA_INVARIANT(!ok(), "Result::error() of a success");
     return std::get<1>(v_);
   }
 
@@ -70,7 +73,7 @@ class [[nodiscard]] Result<void> {
   [[nodiscard]] bool ok() const { return ok_; }
   explicit operator bool() const { return ok_; }
   [[nodiscard]] const Error& error() const {
-    assert(!ok_);
+    CHIMERA_INVARIANT(!ok_, "Result<void>::error() of a success");
     return error_;
   }
 

@@ -7,6 +7,10 @@
 
 namespace chimera {
 
+/// The subsystem's clock: the wall clock with real-time threads, or simulated time (deterministic,
+/// as fast as the machine allows).
+enum class ClockKind { kReal, kVirtual };
+
 /// CLOCK_MONOTONIC in nanoseconds. Real-time safe (vDSO, no system call on Linux x86-64).
 inline std::int64_t monotonic_ns() noexcept {
   timespec ts{};

@@ -71,7 +71,8 @@ class TaskStats {
   void record_skipped(std::uint64_t n) noexcept;
   /// A precedence wait gave up. Real-time safe.
   void record_order_timeout() noexcept;
-  [[nodiscard]] TaskStatsSnapshot snapshot() const noexcept;
+  /// A copy of every figure, histograms included (it allocates). Not real-time safe.
+  [[nodiscard]] TaskStatsSnapshot snapshot() const;
   void reset() noexcept;
 
  private:

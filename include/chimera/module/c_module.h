@@ -25,7 +25,7 @@
  *     return CHIMERA_OK;
  *   }
  *   static const chimera_c_module gain = {
- *       .abi_version = CHIMERA_C_ABI_VERSION, .name = "c_gain", .summary = "y = k u",
+ *       CHIMERA_C_MODULE_STAMP, .name = "c_gain", .summary = "y = k u",
  *       .doc = "...", .state_size = sizeof(gain_state), .declare = gain_declare,
  *       .init = gain_init, .cycle = gain_cycle};
  *   CHIMERA_REGISTER_C_MODULE(gain)
@@ -49,8 +49,9 @@ extern "C" {
 #endif
 /* NOLINTBEGIN(readability-identifier-naming, modernize-*): a C header keeps C's names and forms */
 
-/* The layout of chimera_c_module below; a library built for another one is refused. */
-#define CHIMERA_C_ABI_VERSION 1u
+/* The layout of chimera_c_module below; a library built for another one is refused. Version 2
+ * added struct_size. */
+#define CHIMERA_C_ABI_VERSION 2u
 
 /* A method's outcome: CHIMERA_OK, or a string literal (it must outlive the program). */
 typedef const char* chimera_status;
@@ -140,7 +141,8 @@ int chimera_illegal_configuration(const chimera_ctx* ctx);
 
 /* ---- the module. ---- */
 typedef struct chimera_c_module {
-  uint32_t abi_version; /* CHIMERA_C_ABI_VERSION */
+  uint32_t abi_version; /* CHIMERA_C_ABI_VERSION        these two first, in every version:  */
+  uint32_t struct_size; /* sizeof(chimera_c_module)     write CHIMERA_C_MODULE_STAMP         */
   const char* name;     /* the module type's name in subsystem files */
   const char* summary;  /* one line */
   const char* doc;      /* what it computes, equations, references */
@@ -157,9 +159,15 @@ typedef struct chimera_c_module {
   chimera_status (*sync)(void* state);
 } chimera_c_module;
 
+/* The first two fields of every chimera_c_module, for a designated initializer. */
+#define CHIMERA_C_MODULE_STAMP .abi_version = CHIMERA_C_ABI_VERSION, .struct_size = (uint32_t)sizeof(chimera_c_module)
+
 /* Adds `module` to the module library. `module` must outlive the process (a static object).
- * A problem (another ABI, a missing name or declare, a name taken) is recorded for the loader,
- * which then refuses the library with a message. */
+ * Every field is checked before anything is called: the version and the size of the struct, a
+ * name and a declare function, state_size within reason, and every pointer inside the library
+ * that registers it. A problem (another ABI, a struct of another shape, a missing name or
+ * declare, a name taken) is recorded for the loader, which then refuses the library with a
+ * message naming the field. */
 void chimera_register_c_module(const chimera_c_module* module);
 
 /* Registers `def` (a chimera_c_module object) when the library is loaded. */

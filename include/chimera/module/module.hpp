@@ -37,7 +37,8 @@
 #include "chimera/core/result.hpp"
 #include "chimera/module/declarations.hpp"
 #include "chimera/module/params.hpp"
-#include "chimera/svt/local_table.hpp"
+#include "chimera/svt/elem_type.hpp"
+#include "chimera/svt/port_access.hpp"
 #include "chimera/svt/view.hpp"
 
 namespace chimera {
@@ -118,11 +119,11 @@ struct TaskServices {
 /// What a module receives in init(): its parameters, its typed port views, its timing.
 class InitContext {
  public:
-  InitContext(std::string_view task_name, const Params& params, LocalTable& local, const CycleTiming& timing,
+  InitContext(std::string_view task_name, const Params& params, PortAccess& ports, const CycleTiming& timing,
               const SubsystemFlags& flags, Trigger& trigger, TaskServices services = {})
       : task_name_(task_name),
         params_(params),
-        local_(local),
+        ports_(ports),
         timing_(timing),
         flags_(flags),
         trigger_(trigger),
@@ -132,18 +133,24 @@ class InitContext {
   /// returns an unbound view and makes init fail with a message naming the port.
   template <class T>
   In<T> in(std::string_view port) {
-    auto r = local_.input<T>(port);
-    if (r) return *r;
-    note_failure(r.error().message);
-    return {};
+    std::string error;
+    const PortWindow w = ports_.bind(port, /*input=*/true, kElemTypeOf<T>, error);
+    if (w.data == nullptr) {
+      note_failure(error);
+      return {};
+    }
+    return In<T>(static_cast<const T*>(w.data), w.count, w.freshness);
   }
   /// A view onto output port `port` (out-var or out-const); same failure rule as in().
   template <class T>
   Out<T> out(std::string_view port) {
-    auto r = local_.output<T>(port);
-    if (r) return *r;
-    note_failure(r.error().message);
-    return {};
+    std::string error;
+    const PortWindow w = ports_.bind(port, /*input=*/false, kElemTypeOf<T>, error);
+    if (w.data == nullptr) {
+      note_failure(error);
+      return {};
+    }
+    return Out<T>(static_cast<T*>(w.data), w.count);
   }
 
   /// Aperiodic tasks: run a cycle (after sync()) each time `fd` is readable. The module owns the
@@ -181,7 +188,7 @@ class InitContext {
 
   std::string_view task_name_;
   const Params& params_;
-  LocalTable& local_;
+  PortAccess& ports_;
   const CycleTiming& timing_;
   const SubsystemFlags& flags_;
   Trigger& trigger_;

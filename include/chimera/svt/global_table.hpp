@@ -11,6 +11,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "chimera/core/result.hpp"
@@ -35,7 +36,9 @@ class GlobalTable {
   /// unlinks the region when destroyed. A stale region left by a dead process of the same
   /// name is replaced. Not real-time safe.
   static Result<GlobalTable> create(std::string_view subsystem_name, std::span<const VarSpec> vars);
-  /// Maps an existing region read-write, e.g. from another process. Not real-time safe.
+  /// Maps an existing region read-write, e.g. from another process. A region of another layout
+  /// (detail/shm_layout.hpp's fingerprint differs: another version of Chimera made it) is refused
+  /// with a message saying so. Not real-time safe.
   static Result<GlobalTable> attach(std::string_view subsystem_name);
 
   GlobalTable(GlobalTable&& other) noexcept;
@@ -65,23 +68,29 @@ class GlobalTable {
   /// Completed writes of v so far (0: never written). Real-time safe.
   [[nodiscard]] std::uint64_t version(VarIndex v) const noexcept;
 
-  /// The global illegal-configuration flag (paper 3.4). Real-time safe.
-  void set_illegal_configuration(bool raised) noexcept;
+  /// The global illegal-configuration flag (paper 3.4): raised while anything holds it. Real-time
+  /// safe, any process.
   [[nodiscard]] bool illegal_configuration() const noexcept;
-
-  /// A write split in three, so that tests can stop a writer in the middle of one. `write()` is
-  /// begin_write + store_bytes over all bytes + end_write. Bytes not stored between begin_write
-  /// and end_write hold what the slot held before (a write four back). Real-time safe.
-  void begin_write(VarIndex v) noexcept;
-  void store_bytes(VarIndex v, std::size_t byte_offset, const void* src, std::size_t bytes) noexcept;
-  void end_write(VarIndex v) noexcept;
+  /// How many holds keep the flag raised now (tasks in ERROR, a switch under way, ...).
+  [[nodiscard]] std::uint64_t illegal_configuration_holds() const noexcept;
+  /// One hold more, and one fewer: whoever raises lowers exactly once, so the flag is lowered only
+  /// when the last reason for it has gone, whatever the interleaving (it is a count, changed by
+  /// atomic increments, never a stored true or false). Lowering with no hold is a broken
+  /// invariant. Real-time safe, any thread or process.
+  void raise_illegal_configuration() noexcept;
+  void lower_illegal_configuration() noexcept;
 
  private:
-  friend class LocalTable;  // reads through its own scratch buffer (read_via)
+  friend class LocalTable;             // reads through its own scratch buffer (read_via)
+  friend class GlobalTableTestAccess;  // tests: a write stopped half way (src/svt/global_table_test_access.hpp)
 
   GlobalTable() = default;
   void release() noexcept;
   void locate_blocks();
+  // The write split in three (for GlobalTableTestAccess): begin, some bytes, end.
+  void begin_write(VarIndex v) noexcept;
+  void store_bytes(VarIndex v, std::size_t byte_offset, const void* src, std::size_t bytes) noexcept;
+  void end_write(VarIndex v) noexcept;
   // The reads that registers cannot hold (over 8 words, or not whole words): through `scratch`, or
   // with none given, through stack scratch of read()'s own.
   ReadOutcome read_out_of_line(VarIndex v, void* dst, std::uint64_t seen, std::uint64_t* scratch) const noexcept;
@@ -98,6 +107,25 @@ class GlobalTable {
   std::vector<svt_detail::BlockRef> blocks_;
   std::size_t mapped_bytes_ = 0;
   bool owner_ = false;
+};
+
+/// Holds the illegal-configuration flag of `table` raised while it lives: one raise, one lower.
+/// Real-time safe.
+class IllegalConfigurationHold {
+ public:
+  explicit IllegalConfigurationHold(GlobalTable& table) noexcept : table_(&table) {
+    table_->raise_illegal_configuration();
+  }
+  ~IllegalConfigurationHold() {
+    if (table_ != nullptr) table_->lower_illegal_configuration();
+  }
+  IllegalConfigurationHold(IllegalConfigurationHold&& other) noexcept : table_(std::exchange(other.table_, nullptr)) {}
+  IllegalConfigurationHold& operator=(IllegalConfigurationHold&&) = delete;
+  IllegalConfigurationHold(const IllegalConfigurationHold&) = delete;
+  IllegalConfigurationHold& operator=(const IllegalConfigurationHold&) = delete;
+
+ private:
+  GlobalTable* table_;
 };
 
 }  // namespace chimera

@@ -14,20 +14,14 @@
 #include "chimera/svt/elem_type.hpp"
 #include "chimera/svt/freshness.hpp"
 #include "chimera/svt/global_table.hpp"
+#include "chimera/svt/port_access.hpp"
+#include "chimera/svt/port_binding.hpp"
 #include "chimera/svt/port_kind.hpp"
 #include "chimera/svt/view.hpp"
 
 namespace chimera {
 
-/// One port of a task bound to a variable of the global table (after renaming).
-struct PortBinding {
-  std::string port;      // the module's port name
-  std::string variable;  // the global variable it is bound to
-  PortKind kind;
-  VarShape shape;
-};
-
-class LocalTable {
+class LocalTable final : public PortAccess {
  public:
   /// Allocates local storage for `ports` and resolves each variable in `global` once.
   /// Not real-time safe.
@@ -39,6 +33,8 @@ class LocalTable {
   Result<In<T>> input(std::string_view port);
   template <class T>
   Result<Out<T>> output(std::string_view port);
+  /// PortAccess, for InitContext: the same lookups, untyped. Not real-time safe.
+  PortWindow bind(std::string_view port, bool input, ElemType type, std::string& error) override;
 
   // Transfers (real-time safe): global -> local for inputs, local -> global for outputs.
   void pull_in_consts() noexcept;

@@ -1,4 +1,4 @@
-#include "config/detail/request_loader.hpp"
+#include "detail/request_loader.hpp"
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>

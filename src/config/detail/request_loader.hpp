@@ -6,7 +6,7 @@
 
 #include "chimera/config/subsystem.hpp"
 #include "chimera/core/result.hpp"
-#include "config/detail/yaml_reader.hpp"
+#include "yaml_reader.hpp"
 
 namespace chimera::config_detail {
 

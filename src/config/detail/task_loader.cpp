@@ -1,4 +1,4 @@
-#include "config/detail/task_loader.hpp"
+#include "detail/task_loader.hpp"
 
 #include <algorithm>
 #include <string>

@@ -4,7 +4,7 @@
 #include "chimera/config/subsystem.hpp"
 #include "chimera/core/result.hpp"
 #include "chimera/module/registry.hpp"
-#include "config/detail/yaml_reader.hpp"
+#include "yaml_reader.hpp"
 
 namespace chimera::config_detail {
 

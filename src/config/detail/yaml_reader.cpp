@@ -1,4 +1,4 @@
-#include "config/detail/yaml_reader.hpp"
+#include "detail/yaml_reader.hpp"
 
 #include <algorithm>
 #include <charconv>
@@ -124,13 +124,6 @@ std::optional<bool> as_bool(const YAML::Node& node) {
   if (s == "true" || s == "True" || s == "TRUE") return true;
   if (s == "false" || s == "False" || s == "FALSE") return false;
   return std::nullopt;
-}
-
-bool is_identifier(std::string_view text) {
-  if (text.empty() || (text.front() >= '0' && text.front() <= '9')) return false;
-  return std::all_of(text.begin(), text.end(), [](char c) {
-    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_';
-  });
 }
 
 Result<std::string> read_text(const Source& source, const Field& field) {

@@ -11,6 +11,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "chimera/core/identifier.hpp"
 #include "chimera/core/result.hpp"
 #include "chimera/module/params.hpp"
 
@@ -73,9 +74,6 @@ std::string describe(const YAML::Node& node);
 /// Plain (unquoted, untagged) scalars only: quoting a number makes it text.
 std::optional<double> as_number(const YAML::Node& node);
 std::optional<bool> as_bool(const YAML::Node& node);
-
-/// [A-Za-z_][A-Za-z0-9_]*: task, variable, configuration and constant names.
-bool is_identifier(std::string_view text);
 
 Result<std::string> read_text(const Source& source, const Field& field);
 Result<std::string> read_identifier(const Source& source, const Field& field, std::string_view what);

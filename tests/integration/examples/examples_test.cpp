@@ -15,7 +15,7 @@
 #include <gtest/gtest.h>
 
 #include "chimera/config/loader.hpp"
-#include "chimera/exec/subsystem.hpp"
+#include "chimera/control/subsystem.hpp"
 #include "chimera/module/registry.hpp"
 #include "chimera/reconfig/switch_record.hpp"
 #include "cli/run_chimera.hpp"

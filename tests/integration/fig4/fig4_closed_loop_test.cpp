@@ -14,7 +14,7 @@
 #include <gtest/gtest.h>
 
 #include "chimera/config/loader.hpp"
-#include "chimera/exec/subsystem.hpp"
+#include "chimera/control/subsystem.hpp"
 #include "chimera/module/registry.hpp"
 
 namespace chimera {

@@ -10,7 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "chimera/config/loader.hpp"
-#include "chimera/exec/subsystem.hpp"
+#include "chimera/control/subsystem.hpp"
 #include "chimera/module/registry.hpp"
 #include "joint_traj_gen/quintic_via.hpp"
 #include "pid_joint/pid_law.hpp"

@@ -17,7 +17,7 @@
 #include "cartesian_interp/cartesian_motion.hpp"
 #include "chimera/config/loader.hpp"
 #include "chimera/config/verify.hpp"
-#include "chimera/exec/subsystem.hpp"
+#include "chimera/control/subsystem.hpp"
 #include "chimera/module/registry.hpp"
 #include "support/probe_module.hpp"
 #include "support/udp_sender.hpp"

@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include "control/subsystem_test_access.hpp"
 #include "module_harness.hpp"
 
 namespace chimera::test {
@@ -54,7 +55,7 @@ HoldFigures raise_and_clear(const std::string& text, double resume_tolerance) {
   if (!sub) return out;
   sub->run_for(1200 * kMs);  // in the middle of a move of the default trajectory
   EXPECT_GT(max_abs(value_of(*sub, "dtheta_m")), 0.3) << "the arm should be moving when the flag rises";
-  sub->table().set_illegal_configuration(true);
+  SubsystemTestAccess::table(*sub).raise_illegal_configuration();
   sub->run_for(kMs);  // the next cycle of the interface sees the flag
   const auto held_at = value_of(*sub, "theta_m");
   const auto theta_d_at = value_of(*sub, "theta_d");
@@ -65,7 +66,7 @@ HoldFigures raise_and_clear(const std::string& text, double resume_tolerance) {
   }
   out.speed_at_end_of_hold = max_abs(value_of(*sub, "dtheta_m"));
   out.trajectory_moved = max_abs_difference(value_of(*sub, "theta_d"), theta_d_at);
-  sub->table().set_illegal_configuration(false);
+  SubsystemTestAccess::table(*sub).lower_illegal_configuration();
   sub->run_for(3000 * kMs);
   for (int k = 0; k < 100; ++k) {
     sub->run_for(10 * kMs);
@@ -103,7 +104,7 @@ TEST(IllegalConfigurationHold, HeldMeansStillOnceStopped) {
   for (const char* text : {kTorque, kPosition}) {
     auto sub = start_subsystem(text);
     ASSERT_NE(sub, nullptr);
-    sub->table().set_illegal_configuration(true);
+    SubsystemTestAccess::table(*sub).raise_illegal_configuration();
     sub->run_for(kMs);
     const auto held_at = value_of(*sub, "theta_m");
     sub->run_for(3000 * kMs);  // the trajectory runs through two via points meanwhile

@@ -9,7 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "chimera/config/loader.hpp"
-#include "chimera/exec/subsystem.hpp"
+#include "chimera/control/subsystem.hpp"
 #include "chimera/module/plugin_loader.hpp"
 #include "support/probe_module.hpp"
 

@@ -4,6 +4,8 @@
 #include <unistd.h>
 
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -83,6 +85,24 @@ TEST_F(PluginCliTest, AModuleThatDeclaresPortsBadlyIsRefusedWithItsFlaw) {
   EXPECT_EXIT_CODE(o, 2);
   EXPECT_TRUE(o.err.starts_with(f + ":2: plugins[0]: 'libchimera_test_bad_name.so' (")) << o.err;
   EXPECT_TRUE(contains(o.err, "module test_flawed: port 'theta d' is not a valid name")) << o.err;
+}
+
+TEST_F(PluginCliTest, ALibraryBuiltForAnotherAbiIsOneMessageAndExit2NotACrash) {
+  // A C++ library built against a stale module.hpp, and a C library whose struct lacks a field:
+  // both loaded, verified and then crashed before; now they are refused at load, naming why.
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {"libchimera_test_stale_cxx.so", "rebuild the library against this version"},
+      {"libchimera_test_c_lacks_state_size.so", "its state_size is "}};
+  for (const auto& [lib, why] : cases) {
+    const std::string f = file("stale.yaml", "plugins: [" + lib + "]\ntasks: []\n");
+    for (const char* command : {"verify ", "run "}) {
+      const auto o = chimera(command + quoted(f) + (command[0] == 'r' ? " --clock virtual --for 10ms" : ""), {}, kBad);
+      EXPECT_EXIT_CODE(o, 2);
+      EXPECT_TRUE(o.err.starts_with(f + ":2: plugins[0]: '" + lib + "' (")) << o.err;
+      EXPECT_TRUE(contains(o.err, why)) << o.err;
+      EXPECT_EQ(o.err.find('\n'), o.err.size() - 1) << "one line: " << o.err;
+    }
+  }
 }
 
 TEST_F(PluginCliTest, ModulesListsWhatThePathOffersWithTheLibrary) {

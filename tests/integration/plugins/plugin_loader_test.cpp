@@ -6,6 +6,8 @@
 
 #include <unistd.h>
 
+#include <array>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -163,10 +165,32 @@ TEST(LoadPlugin, AModuleNameTakenAlready) {
 
 TEST(LoadPlugin, ACModuleOfAnotherAbi) {
   const std::string message = load_error(bad("libchimera_test_c_other_abi.so"));
-  EXPECT_TRUE(contains(message,
-                       "C module 'test_c_other_abi' was built for C ABI version 42, but this chimera has "
-                       "version 1"))
+  EXPECT_TRUE(contains(message, "a C module was built for C ABI version 43, but this chimera has version 2"))
       << message;
+}
+
+TEST(LoadPlugin, ACModuleWhoseStructHasAnotherShapeIsRefusedByItsFields) {
+  // Today's version and size, but no state_size: every later field is one place off. Nothing of
+  // it may be called; the message names the field that gave it away.
+  const std::string message = load_error(bad("libchimera_test_c_lacks_state_size.so"));
+  EXPECT_TRUE(contains(message, "C module 'test_c_shorter': its state_size is ")) << message;
+  EXPECT_TRUE(contains(message, "built against another chimera/module/c_module.h")) << message;
+  EXPECT_EQ(Registry::global().find("test_c_shorter"), nullptr);
+}
+
+TEST(LoadPlugin, ACxxModuleBuiltAgainstStaleHeadersIsRefusedBeforeAnyOfItRuns) {
+  // Built against a module.hpp with one more virtual method: its vtable is not ours. The stamp
+  // CHIMERA_REGISTER_MODULE put into it says so, before its add function could run.
+  const std::string message = load_error(bad("libchimera_test_stale_cxx.so"));
+  EXPECT_TRUE(
+      contains(message, "module my_module was built for Chimera " + std::string(kChimeraVersion) + " (module ABI "))
+      << message;
+  std::array<char, 128> ours{};
+  std::snprintf(ours.data(), ours.size(), "but this is Chimera %s (module ABI %016llx)", kChimeraVersion,
+                static_cast<unsigned long long>(kModuleAbiFingerprint));
+  EXPECT_TRUE(contains(message, ours.data())) << message;
+  EXPECT_TRUE(contains(message, "rebuild the library against this version")) << message;
+  EXPECT_EQ(Registry::global().origin("my_module").find("stale"), std::string_view::npos);
 }
 
 TEST(PluginsOnPath, EverySharedLibraryOfEachDirectoryOnce) {

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "chimera/svt/global_table.hpp"
+#include "svt/global_table_test_access.hpp"
 #include "unit/svt/svt_test_support.hpp"
 
 namespace chimera {
@@ -70,12 +71,13 @@ TEST_P(PreemptedWriter, ReadersGetTheLastWholeValueWithoutWaiting) {
   std::promise<void> resume;
   std::thread writer([&] {
     const std::vector<double> value(kCount, b);
-    table->begin_write(0);
-    table->store_bytes(0, 0, value.data(), kCount / 2 * sizeof(double));
+    GlobalTableTestAccess::begin_write(*table, 0);
+    GlobalTableTestAccess::store_bytes(*table, 0, 0, value.data(), kCount / 2 * sizeof(double));
     paused.set_value();
     resume.get_future().wait();
-    table->store_bytes(0, kCount / 2 * sizeof(double), value.data() + kCount / 2, kCount / 2 * sizeof(double));
-    table->end_write(0);
+    GlobalTableTestAccess::store_bytes(*table, 0, kCount / 2 * sizeof(double), value.data() + kCount / 2,
+                                       kCount / 2 * sizeof(double));
+    GlobalTableTestAccess::end_write(*table, 0);
   });
   paused.get_future().wait();
 
@@ -102,7 +104,7 @@ TEST(PreemptedWriter, ReadersOfOtherVariablesAreUnaffected) {
   const std::vector<VarSpec> vars{{"stuck", {ElemType::kF64, kCount}}, {"moving", {ElemType::kF64, kCount}}};
   auto table = GlobalTable::create(test::unique_subsystem("preempt_other"), vars);
   ASSERT_TRUE(table) << table.error().message;
-  table->begin_write(0);  // never finished in this test
+  GlobalTableTestAccess::begin_write(*table, 0);  // never finished in this test
   const std::vector<double> value(kCount, 3.0);
   table->write(1, value.data());
   EXPECT_EQ(reads_elsewhere(*table, 1, 0, 0.0, Freshness::kNew, 1, 3.0), 0U);

@@ -10,7 +10,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
-#include "chimera/exec/subsystem.hpp"
+#include "chimera/control/subsystem.hpp"
 #include "unit/control/test_modules.hpp"
 
 namespace chimera {

@@ -8,7 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "chimera/control/stats_json.hpp"
-#include "chimera/control/text_table.hpp"
+#include "chimera/core/text_table.hpp"
 
 namespace chimera {
 namespace {
@@ -40,25 +40,6 @@ std::vector<std::string> lines_of(const std::string& text) {
   std::istringstream in(text);
   for (std::string line; std::getline(in, line);) out.push_back(line);
   return out;
-}
-
-TEST(FormatDuration, PicksTheUnitThatKeepsTheNumberShort) {
-  EXPECT_EQ(format_duration(0), "0 ns");
-  EXPECT_EQ(format_duration(850), "850 ns");
-  EXPECT_EQ(format_duration(12'345), "12.3 µs");
-  EXPECT_EQ(format_duration(999'949), "999.9 µs");
-  EXPECT_EQ(format_duration(1'250'000), "1.25 ms");
-  EXPECT_EQ(format_duration(2'000'000'000), "2.000 s");
-}
-
-TEST(FormatPeriod, ReadsAsTheFileWroteIt) {
-  EXPECT_EQ(format_period(0), "aperiodic");
-  EXPECT_EQ(format_period(1'000'000), "1 ms");
-  EXPECT_EQ(format_period(30'000'000), "30 ms");
-  EXPECT_EQ(format_period(250'000), "250 µs");
-  EXPECT_EQ(format_period(2'000'000'000), "2 s");
-  EXPECT_EQ(format_period(30'303'030), "30.303 ms");  // 33Hz
-  EXPECT_EQ(format_period(500), "500 ns");
 }
 
 TEST(TextTable, AlignsByCodePoints) {

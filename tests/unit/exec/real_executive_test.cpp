@@ -14,7 +14,7 @@
 #include <gtest/gtest.h>
 
 #include "chimera/config/loader.hpp"
-#include "chimera/exec/subsystem.hpp"
+#include "chimera/control/subsystem.hpp"
 #include "support/trace_module.hpp"
 
 namespace chimera {
@@ -206,14 +206,14 @@ TEST(OverrunWatch, AHardJobStuckInCycleIsReportedWhileItLastsAndKeepsTheFlagUp) 
   EXPECT_NE(seen.back().text.find("illegal-configuration flag is up"), std::string::npos) << seen.back().text;
   // While it lasts: the flag is up, the task is still ON (its error() cannot run inside cycle()),
   // and the other task runs on.
-  EXPECT_TRUE(s->table().illegal_configuration());
+  EXPECT_TRUE(s->illegal_configuration());
   auto snap = s->snapshot();
   EXPECT_EQ(snap[0].state, TaskState::kOn);
   const auto counted = s->get("count")->at(0);
   s->run_for(100 * kMs);
   EXPECT_GT(s->get("count")->at(0), counted) << "the other task stops with the stuck one";
   EXPECT_EQ(count_events(seen, "stuck", "still running"), 1u) << "one report per stuck job";
-  EXPECT_TRUE(s->table().illegal_configuration());
+  EXPECT_TRUE(s->illegal_configuration());
 
   // Released: the job ends late, a hard task's miss: error() does not recover, so ERROR (and the
   // flag stays up for that reason).
@@ -222,7 +222,7 @@ TEST(OverrunWatch, AHardJobStuckInCycleIsReportedWhileItLastsAndKeepsTheFlagUp) 
   for (auto& e : s->drain_events()) seen.push_back(std::move(e));
   EXPECT_EQ(count_events(seen, "stuck", "still running"), 1u);
   EXPECT_EQ(s->snapshot()[0].state, TaskState::kError);
-  EXPECT_TRUE(s->table().illegal_configuration());
+  EXPECT_TRUE(s->illegal_configuration());
   s->stop();
 }
 
@@ -232,12 +232,12 @@ TEST(OverrunWatch, TheFlagGoesDownWhenAStuckHardJobEndsAndItsTaskRecovers) {
   ASSERT_TRUE(s->start().ok());
   std::vector<Event> seen;
   ASSERT_TRUE(wait_for_event(*s, "stuck", "still running", seen));
-  EXPECT_TRUE(s->table().illegal_configuration());
+  EXPECT_TRUE(s->illegal_configuration());
   testing::stall_released().store(true, std::memory_order_release);  // release: the staller's acquire
   bool lowered = false;
   for (int i = 0; i < 500 && !lowered; ++i) {
     s->run_for(10 * kMs);
-    lowered = !s->table().illegal_configuration();
+    lowered = !s->illegal_configuration();
   }
   EXPECT_TRUE(lowered) << "the flag stayed up after the job ended and error() recovered";
   EXPECT_EQ(s->snapshot()[0].state, TaskState::kOn);
@@ -252,7 +252,7 @@ TEST(OverrunWatch, ASoftJobStuckInCycleIsReportedWithoutTheFlag) {
   std::vector<Event> seen;
   ASSERT_TRUE(wait_for_event(*s, "stuck", "still running", seen));
   EXPECT_NE(seen.back().text.find("Soft"), std::string::npos) << seen.back().text;
-  EXPECT_FALSE(s->table().illegal_configuration());
+  EXPECT_FALSE(s->illegal_configuration());
   testing::stall_released().store(true, std::memory_order_release);  // release: the staller's acquire
   s->stop();
 }

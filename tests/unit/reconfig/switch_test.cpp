@@ -7,7 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "chimera/config/loader.hpp"
-#include "chimera/exec/subsystem.hpp"
+#include "chimera/control/subsystem.hpp"
 #include "support/reconfig_modules.hpp"
 #include "support/run_subsystem.hpp"
 
@@ -71,7 +71,7 @@ TEST(Switch, TheFlagIsUpWhileASwitchCreatesTasks) {
   EXPECT_EQ(first->spawned, (std::vector<std::string>{"b"}));
   EXPECT_EQ(first->committed_ns - first->requested_ns, 1 * kMs) << "the old configuration ran one more cycle";
   EXPECT_EQ(value(*s, "flag_cycles"), 1.0) << "modules saw the flag up during that cycle";
-  EXPECT_FALSE(s->table().illegal_configuration()) << "and lowered once committed";
+  EXPECT_FALSE(s->illegal_configuration()) << "and lowered once committed";
   auto back = s->switch_to("with_a");
   ASSERT_TRUE(back.ok());
   EXPECT_FALSE(back->flag_raised) << "every task exists: the commit is immediate";
@@ -105,7 +105,7 @@ TEST(Switch, ARefusedSwitchChangesNothing) {
     EXPECT_EQ(after[i].state, before[i].state) << after[i].name;
     EXPECT_EQ(after[i].stats.cycles, before[i].stats.cycles) << after[i].name;
   }
-  EXPECT_FALSE(s->table().illegal_configuration());
+  EXPECT_FALSE(s->illegal_configuration());
 }
 
 const std::string kTools = R"(subsystem: tools
@@ -169,7 +169,7 @@ TEST(Switch, AroundATaskInError) {
   ASSERT_TRUE(s);
   s->run_for(5 * kMs);
   ASSERT_EQ(task(*s, "p").state, TaskState::kError);
-  EXPECT_TRUE(s->table().illegal_configuration()) << "the flag also marks an error in the subsystem";
+  EXPECT_TRUE(s->illegal_configuration()) << "the flag also marks an error in the subsystem";
   auto refused = s->switch_to("with_b_and_p");
   ASSERT_FALSE(refused.ok());
   EXPECT_EQ(refused.error().message, "switch to 'with_b_and_p' refused: p is in ERROR (clear it first)");
@@ -181,7 +181,7 @@ TEST(Switch, AroundATaskInError) {
   s->run_for(5 * kMs);
   EXPECT_EQ(value(*s, "stale"), 0.0);
   ASSERT_TRUE(s->signal("p", Signal::kClear).ok());
-  EXPECT_FALSE(s->table().illegal_configuration()) << "cleared: no task in ERROR, the flag is down";
+  EXPECT_FALSE(s->illegal_configuration()) << "cleared: no task in ERROR, the flag is down";
 }
 
 const std::string kRequests = R"(subsystem: req

@@ -11,8 +11,9 @@
 #include <gtest/gtest.h>
 
 #include "chimera/svt/detail/seq_protocol.hpp"
+#include "chimera/svt/detail/shm_layout.hpp"
 #include "chimera/svt/global_table.hpp"
-#include "svt/shm_layout.hpp"
+#include "svt/global_table_test_access.hpp"
 #include "unit/svt/svt_test_support.hpp"
 
 namespace chimera {
@@ -164,19 +165,19 @@ TEST_F(ProtocolTest, SplitWriteIsInvisibleUntilItEnds) {
   const auto a = pattern(13, 1);
   const auto b = pattern(13, 2);
   table().write(v, a.data());
-  table().begin_write(v);
+  GlobalTableTestAccess::begin_write(table(), v);
   // Uneven pieces cross word boundaries: 0..3, 3..10, 10..13.
-  table().store_bytes(v, 0, b.data(), 3);
-  table().store_bytes(v, 3, b.data() + 3, 7);
+  GlobalTableTestAccess::store_bytes(table(), v, 0, b.data(), 3);
+  GlobalTableTestAccess::store_bytes(table(), v, 3, b.data() + 3, 7);
   std::vector<std::byte> got(13);
   ReadOutcome r = table().read(v, got.data(), 0);
   EXPECT_EQ(r.freshness, Freshness::kNew);
   EXPECT_EQ(r.version, 1U);
   EXPECT_EQ(got, a);
   EXPECT_EQ(table().read(v, got.data(), 1).freshness, Freshness::kOld);
-  table().store_bytes(v, 10, b.data() + 10, 3);
+  GlobalTableTestAccess::store_bytes(table(), v, 10, b.data() + 10, 3);
   EXPECT_EQ(table().version(v), 1U);
-  table().end_write(v);
+  GlobalTableTestAccess::end_write(table(), v);
   r = table().read(v, got.data(), 1);
   EXPECT_EQ(r.freshness, Freshness::kNew);
   EXPECT_EQ(r.version, 2U);
@@ -232,16 +233,16 @@ TEST_F(LappingTest, AWriterStillInTheSlotIsDetected) {
   const std::uint64_t v = d::read_version(block_);
   const std::uint64_t s1 = d::read_open(block_, v);
   for (double k = 6; k <= 8; ++k) write_value(k);
-  table().begin_write(v_);  // write 9 starts on slot 9 % 4 == 5 % 4 and stops half way
+  GlobalTableTestAccess::begin_write(table(), v_);  // write 9 starts on slot 9 % 4 == 5 % 4 and stops half way
   const std::array<double, 3> half{9, 9, 9};
-  table().store_bytes(v_, 0, half.data(), sizeof(half));
+  GlobalTableTestAccess::store_bytes(table(), v_, 0, half.data(), sizeof(half));
   std::array<std::uint64_t, 6> words{};
   d::read_copy(block_, v, words.data());
   EXPECT_FALSE(d::read_close(block_, v, s1));
   // A reader opening after the lap sees the slot is not write v's any more.
   EXPECT_NE(d::read_open(block_, v), 2 * v);
-  table().store_bytes(v_, sizeof(half), half.data(), sizeof(half));
-  table().end_write(v_);
+  GlobalTableTestAccess::store_bytes(table(), v_, sizeof(half), half.data(), sizeof(half));
+  GlobalTableTestAccess::end_write(table(), v_);
   // The public read meanwhile always gets the newest whole value.
   std::array<double, 6> got{};
   const ReadOutcome r = table().read(v_, got.data(), 0);

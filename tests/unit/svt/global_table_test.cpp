@@ -9,14 +9,16 @@
 #include <unistd.h>
 
 #include <array>
+#include <atomic>
 #include <cstring>
 #include <set>
+#include <thread>
 #include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
 
-#include "svt/shm_layout.hpp"
+#include "chimera/svt/detail/shm_layout.hpp"
 #include "unit/svt/svt_test_support.hpp"
 
 namespace chimera {
@@ -238,9 +240,27 @@ TEST(GlobalTableLifetime, AttachRefusesAnotherLayoutVersion) {
   header->layout_version = d::kLayoutVersion + 1;
   auto attached = GlobalTable::attach(name);
   ASSERT_FALSE(attached);
-  EXPECT_NE(attached.error().message.find("layout version"), std::string::npos) << attached.error().message;
+  EXPECT_NE(attached.error().message.find("another version of Chimera"), std::string::npos) << attached.error().message;
   header->layout_version = d::kLayoutVersion;
   EXPECT_TRUE(GlobalTable::attach(name));
+  // The same version word but another shape behind it (a build whose header differs only where
+  // the version was not bumped): the fingerprint tells them apart.
+  header->layout_fingerprint = d::kLayoutFingerprint ^ 1U;
+  EXPECT_FALSE(GlobalTable::attach(name));
+  header->layout_fingerprint = d::kLayoutFingerprint;
+  EXPECT_TRUE(GlobalTable::attach(name));
+}
+
+TEST(GlobalTableLayout, TheFingerprintChangesWithEveryIngredient) {
+  // The version is computed from the shape, never kept in step by hand: any constant, size or
+  // offset that enters it moves it.
+  const std::uint64_t base = d::fingerprint({d::kSlots, d::kCacheLine, sizeof(d::Header), sizeof(d::DirEntry)});
+  EXPECT_NE(base, d::fingerprint({d::kSlots + 1, d::kCacheLine, sizeof(d::Header), sizeof(d::DirEntry)}));
+  EXPECT_NE(base, d::fingerprint({d::kSlots, d::kCacheLine, sizeof(d::Header) + 8, sizeof(d::DirEntry)}));
+  EXPECT_NE(base, d::fingerprint({d::kSlots, d::kCacheLine, sizeof(d::Header), sizeof(d::DirEntry) + 8}));
+  EXPECT_NE(base, d::fingerprint({d::kCacheLine, d::kSlots, sizeof(d::Header), sizeof(d::DirEntry)}))
+      << "order matters";
+  EXPECT_EQ(d::kLayoutVersion, static_cast<std::uint32_t>(d::kLayoutFingerprint ^ (d::kLayoutFingerprint >> 32U)));
 }
 
 TEST(GlobalTableLifetime, AttachRefusesADamagedDirectory) {
@@ -294,11 +314,48 @@ TEST(GlobalTableFlag, IllegalConfigurationIsSharedThroughTheRegion) {
   auto other = GlobalTable::attach(name);
   ASSERT_TRUE(other) << other.error().message;
   EXPECT_FALSE(owner->illegal_configuration());
-  other->set_illegal_configuration(true);
+  other->raise_illegal_configuration();
   EXPECT_TRUE(owner->illegal_configuration());
   EXPECT_TRUE(other->illegal_configuration());
-  owner->set_illegal_configuration(false);
+  owner->raise_illegal_configuration();
+  EXPECT_EQ(other->illegal_configuration_holds(), 2U);
+  other->lower_illegal_configuration();
+  EXPECT_TRUE(owner->illegal_configuration()) << "one hold is left: the flag stays up";
+  owner->lower_illegal_configuration();
   EXPECT_FALSE(other->illegal_configuration());
+}
+
+TEST(GlobalTableFlag, RaisersAndLowerersOnManyThreadsNeverLoseAHold) {
+  // Each thread raises and lowers in turn; one more hold is kept throughout. Whatever the
+  // interleaving, the flag never reads down while that hold lasts, and reads down at the end.
+  const auto name = unique_subsystem("flagrace");
+  auto table = GlobalTable::create(name, fig4_vars());
+  ASSERT_TRUE(table) << table.error().message;
+  table->raise_illegal_configuration();
+  std::atomic<bool> ever_down{false};
+  std::vector<std::thread> threads;
+  for (int t = 0; t < 4; ++t) {
+    threads.emplace_back([&] {
+      for (int i = 0; i < 20'000; ++i) {
+        table->raise_illegal_configuration();
+        if (!table->illegal_configuration()) ever_down.store(true, std::memory_order_relaxed);  // a verdict only
+        table->lower_illegal_configuration();
+        if (!table->illegal_configuration()) ever_down.store(true, std::memory_order_relaxed);  // as above
+      }
+    });
+  }
+  for (auto& t : threads) t.join();
+  EXPECT_FALSE(ever_down.load());
+  EXPECT_EQ(table->illegal_configuration_holds(), 1U);
+  table->lower_illegal_configuration();
+  EXPECT_FALSE(table->illegal_configuration());
+}
+
+TEST(GlobalTableFlagDeathTest, LoweringWithoutAHoldIsABrokenInvariant) {
+  const auto name = unique_subsystem("flagunder");
+  auto table = GlobalTable::create(name, fig4_vars());
+  ASSERT_TRUE(table) << table.error().message;
+  EXPECT_DEATH(table->lower_illegal_configuration(), "invariant broken: the illegal-configuration flag lowered");
 }
 
 }  // namespace

@@ -1,8 +1,9 @@
 #pragma once
 // The state variable protocol (docs/state-variables.md): a sequence counter per slot, kSlots slots
-// per variable, one writer per variable (rule 1). Installed because GlobalTable's reads and writes
-// are inline (detail/global_table.inl): a call into the library cost a 6-double read more than the
-// read itself. Not an API: only src/svt, the inline bodies and the protocol's tests use it.
+// per variable (the shape is detail/shm_layout.hpp's), one writer per variable (rule 1).
+// Installed because GlobalTable's reads and writes are inline (detail/global_table.inl): a call
+// into the library cost a 6-double read more than the read itself. Not an API: only src/svt, the
+// inline bodies and the protocol's tests use it.
 //
 // Writer of write w (w = version + 1):
 //   seq[w % kSlots] = 2w-1 (relaxed); release fence; payload words (relaxed);
@@ -18,11 +19,13 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cassert>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
 #include <new>
+
+#include "chimera/core/invariant.hpp"
+#include "chimera/svt/detail/shm_layout.hpp"
 
 // ThreadSanitizer does not model standalone fences, so under it the fences are replaced by
 // release stores and acquire loads of the payload words, which TSAN does understand.
@@ -35,26 +38,6 @@
 #endif
 
 namespace chimera::svt_detail {
-
-/// Slots per variable. Two would do for a writer preempted mid-write (the latch idea); four give
-/// a reader three whole writes of grace before a fast writer can reuse the slot it is copying.
-inline constexpr std::uint64_t kSlots = 4;
-
-/// The words of one variable's block (src/svt/shm_layout.hpp), located once per table in this
-/// process's mapping.
-struct BlockRef {
-  std::uint64_t* version;  // its own cache line
-  std::byte* slots;        // slot k starts at slots + k * slot_stride
-  std::uint64_t slot_stride;
-  std::uint32_t words;
-  std::uint32_t bytes;  // payload bytes actually used (<= 8 * words)
-
-  [[nodiscard]] std::uint64_t* seq(std::uint64_t slot) const noexcept {
-    // NOLINTNEXTLINE(cppcoreguidelines-pro-type-reinterpret-cast): a slot starts with its seq word
-    return std::launder(reinterpret_cast<std::uint64_t*>(slots + slot * slot_stride));
-  }
-  [[nodiscard]] std::uint64_t* payload(std::uint64_t slot) const noexcept { return seq(slot) + 1; }
-};
 
 using Word = std::atomic_ref<std::uint64_t>;
 
@@ -117,7 +100,7 @@ inline void write_begin(const BlockRef& b, std::uint64_t w) noexcept {
 /// bytes from what the slot held (the caller stores every byte before write_end).
 inline void write_bytes(const BlockRef& b, std::uint64_t w, std::size_t offset, const std::byte* src,
                         std::size_t bytes) noexcept {
-  assert(offset + bytes <= b.bytes && "store beyond the variable");
+  CHIMERA_INVARIANT(offset + bytes <= b.bytes, "a store beyond the variable");
   std::uint64_t* words = b.payload(w % kSlots);
   std::size_t pos = offset;
   const std::size_t stop = offset + bytes;

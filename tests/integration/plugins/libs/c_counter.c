@@ -74,7 +74,7 @@ static chimera_status counter_error(void* self) {
 }
 
 static const chimera_c_module counter = {
-    .abi_version = CHIMERA_C_ABI_VERSION,
+    CHIMERA_C_MODULE_STAMP,
     .name = "test_c_counter",
     .summary = "counts cycles (test plugin in C)",
     .doc = "count = offset + cycles since on.",

@@ -8,6 +8,7 @@ static void other_declare(chimera_decl* d, const chimera_params* p) {
 
 static const chimera_c_module other = {
     .abi_version = CHIMERA_C_ABI_VERSION + 41u,
+    .struct_size = (uint32_t)sizeof(chimera_c_module),
     .name = "test_c_other_abi",
     .summary = "from the future",
     .doc = "",

@@ -15,9 +15,9 @@
 #include <gtest/gtest.h>
 
 #include "chimera/svt/detail/seq_protocol.hpp"
+#include "chimera/svt/detail/shm_layout.hpp"
 #include "chimera/svt/global_table.hpp"
 #include "chimera/svt/local_table.hpp"
-#include "svt/shm_layout.hpp"
 #include "unit/svt/svt_test_support.hpp"
 
 namespace chimera {

@@ -6,6 +6,11 @@
 //
 // A task's methods are called by one thread at a time: its own thread on the real clock, the
 // simulation thread on the virtual clock. state() and stats() may be read from anywhere.
+//
+// A task in ERROR holds the illegal-configuration flag (paper 3.4: it "can also be used to
+// indicate the presence of an error in the system"): one hold, taken as it enters ERROR and given
+// back as it leaves, so no interleaving with other raisers can lower the flag meanwhile.
+// Exported to the parts above (not installed).
 
 #include <array>
 #include <atomic>
@@ -17,12 +22,12 @@
 
 #include "chimera/config/verify.hpp"
 #include "chimera/core/result.hpp"
-#include "chimera/exec/event_ring.hpp"
 #include "chimera/exec/stats.hpp"
 #include "chimera/lifecycle/state.hpp"
 #include "chimera/module/module.hpp"
 #include "chimera/svt/global_table.hpp"
 #include "chimera/svt/local_table.hpp"
+#include "event_ring.hpp"
 
 namespace chimera {
 
@@ -87,6 +92,9 @@ class Task {
   [[nodiscard]] std::int64_t absolute_deadline(std::int64_t release_ns) const noexcept;
   /// What wakes this aperiodic task, as its module declared in init (empty for periodic ones).
   [[nodiscard]] const Trigger& trigger() const noexcept { return trigger_; }
+  /// The global index of the variable whose updates wake it (its trigger's update port), -1 for
+  /// none; fixed at spawn. Real-time safe.
+  [[nodiscard]] int trigger_var() const noexcept { return trigger_var_; }
   /// Real clock: how exec times are measured (set before spawn).
   void set_exec_clock(ExecClock clock) noexcept { exec_clock_ = clock; }
   /// Marks the subsystem's clock as virtual in the timing modules see (set before spawn).
@@ -137,6 +145,7 @@ class Task {
   std::unique_ptr<LocalTable> local_;
   CycleTiming timing_;
   Trigger trigger_;
+  int trigger_var_ = -1;
   TaskServices services_;
   ExecClock exec_clock_ = ExecClock::kWall;
   bool virtual_clock_ = false;

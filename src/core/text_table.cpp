@@ -1,4 +1,4 @@
-#include "chimera/control/text_table.hpp"
+#include "chimera/core/text_table.hpp"
 
 #include <algorithm>
 

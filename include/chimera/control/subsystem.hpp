@@ -1,7 +1,9 @@
 #pragma once
-// A running subsystem: the global table, its tasks, and the executive that releases them on the
-// real clock (one real-time thread per task) or the virtual clock (deterministic, as fast as the
-// machine allows). The shell, the CLI and later the network API all drive it through this API.
+// A running subsystem as the subsystem interface drives it (paper 3.3: the signals "from a user
+// through a command-line or graphical interface, from an external subsystem"): the global table,
+// its tasks, the executive that releases them on the real clock (real-time threads) or the
+// virtual clock (deterministic, as fast as the machine allows), and its reconfiguration. The
+// shell, the CLI and the network API all drive it through this API.
 
 #include <cstdint>
 #include <memory>
@@ -13,15 +15,14 @@
 #include "chimera/config/subsystem.hpp"
 #include "chimera/config/verify.hpp"
 #include "chimera/core/result.hpp"
+#include "chimera/exec/clock.hpp"
+#include "chimera/exec/event.hpp"
 #include "chimera/exec/stats.hpp"
 #include "chimera/lifecycle/state.hpp"
 #include "chimera/module/registry.hpp"
 #include "chimera/reconfig/switch_record.hpp"
-#include "chimera/svt/global_table.hpp"
 
 namespace chimera {
-
-enum class ClockKind { kReal, kVirtual };
 
 struct RunOptions {
   ClockKind clock = ClockKind::kReal;
@@ -45,15 +46,6 @@ struct TaskSnapshot {
   TaskStatsSnapshot stats;
   std::string last_error;  // the last method failure, "" if none
 };
-
-/// Something the subsystem interface should tell the operator (a task entering ERROR, say).
-struct Event {
-  std::int64_t time_ns = 0;
-  std::string task;
-  std::string text;
-};
-
-class Executive;
 
 class Subsystem {
  public:
@@ -90,7 +82,7 @@ class Subsystem {
   [[nodiscard]] std::vector<SwitchRecord> switches() const;
   /// Off, then kill, every task; removes the shared memory. Idempotent. Afterwards snapshot()
   /// and drain_events() still answer (the run's figures and last events); signal, get and set
-  /// are refused, and table() must not be called.
+  /// are refused.
   void stop();
 
   /// Time since start on the subsystem's clock.
@@ -98,7 +90,8 @@ class Subsystem {
   [[nodiscard]] ClockKind clock() const;
   [[nodiscard]] const SubsystemSpec& spec() const;
   [[nodiscard]] const ResolvedSubsystem& resolved() const;
-  [[nodiscard]] GlobalTable& table();
+  /// Whether the illegal-configuration flag is up now (paper 3.4). Any thread.
+  [[nodiscard]] bool illegal_configuration() const;
 
   /// The current value of a variable, converted to doubles; and a write by the operator,
   /// refused if an ON task produces the variable.
@@ -113,10 +106,8 @@ class Subsystem {
   [[nodiscard]] bool hard_task_failed() const;
 
  private:
+  friend class SubsystemTestAccess;  // tests: the table itself (src/control/subsystem_test_access.hpp)
   Subsystem();
-  /// Carries out (or refuses, with an event) the switches tasks asked for.
-  void serve_requests();
-  Result<SwitchRecord> switch_locked(std::string_view name, std::string_view cause, std::int64_t requested_ns);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -1,12 +1,16 @@
-#include "analysis/detail/duration_text.hpp"
+#include "chimera/core/duration_text.hpp"
 
 #include <array>
 #include <string_view>
 
 #include <fmt/format.h>
 
-namespace chimera::analysis::detail {
+namespace chimera {
 namespace {
+
+constexpr std::int64_t kUs = 1'000;
+constexpr std::int64_t kMs = 1'000'000;
+constexpr std::int64_t kS = 1'000'000'000;
 
 struct Unit {
   std::int64_t ns;
@@ -32,8 +36,29 @@ std::string in_unit(std::int64_t thousandths, const Unit& unit, DurationStyle st
 
 }  // namespace
 
-std::string duration_text(std::int64_t ns, DurationStyle style) {
-  if (ns < 0) return fmt::format("-{}", duration_text(-ns, style));  // (not "-" + ...: GCC 12's -Wrestrict misfires)
+std::string format_duration(std::int64_t ns) {
+  const auto v = static_cast<double>(ns);
+  const std::int64_t magnitude = ns < 0 ? -ns : ns;
+  if (magnitude < kUs) return fmt::format("{} ns", ns);
+  if (magnitude < kMs) return fmt::format("{:.1f} µs", v / kUs);
+  if (magnitude < kS) return fmt::format("{:.2f} ms", v / kMs);
+  return fmt::format("{:.3f} s", v / kS);
+}
+
+std::string format_period(std::int64_t ns) {
+  if (ns <= 0) return "aperiodic";
+  // Exact values read as the file wrote them; others (e.g. from a frequency) fall back.
+  if (ns % kS == 0) return fmt::format("{} s", ns / kS);
+  if (ns >= kMs && ns % kMs == 0) return fmt::format("{} ms", ns / kMs);
+  if (ns >= kUs && ns % kUs == 0) return fmt::format("{} µs", ns / kUs);
+  if (ns < kUs) return fmt::format("{} ns", ns);
+  if (ns < kMs) return fmt::format("{:.3f} µs", static_cast<double>(ns) / kUs);
+  return fmt::format("{:.3f} ms", static_cast<double>(ns) / kMs);
+}
+
+std::string exact_duration_text(std::int64_t ns, DurationStyle style) {
+  if (ns < 0)
+    return fmt::format("-{}", exact_duration_text(-ns, style));  // (not "-" + ...: GCC 12's -Wrestrict misfires)
   std::size_t first = 0;
   while (first < kUnits.size() && ns < kUnits[first].ns) ++first;
   if (first == kUnits.size()) return fmt::format("{}{}ns", ns, style == DurationStyle::kDisplay ? " " : "");
@@ -51,4 +76,4 @@ std::string duration_text(std::int64_t ns, DurationStyle style) {
   return in_unit((ns + step - 1) / step, kUnits[last], style);
 }
 
-}  // namespace chimera::analysis::detail
+}  // namespace chimera

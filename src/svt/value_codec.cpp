@@ -1,4 +1,4 @@
-#include "value_codec.hpp"
+#include "chimera/svt/value_codec.hpp"
 
 #include <cmath>
 #include <cstdint>

@@ -1,0 +1,265 @@
+// The running subsystem: what it is made of, and the subsystem interface's operations on it. Each
+// operation is the executive's or the reconfiguration's; this file only puts them in order and
+// serialises them (ops_mutex): it chooses no clock.
+
+#include "chimera/control/subsystem.hpp"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <mutex>
+
+#include <fmt/format.h>
+
+#include "chimera/svt/global_table.hpp"
+#include "chimera/svt/value_codec.hpp"
+#include "exec/event_log.hpp"
+#include "exec/executive.hpp"
+#include "exec/task_set.hpp"
+#include "reconfig/reconfiguration.hpp"
+#include "reconfig/request_board.hpp"
+#include "subsystem_test_access.hpp"
+
+namespace chimera {
+
+namespace {
+
+std::string join_lines(const std::vector<Violation>& violations) {
+  std::string out;
+  for (const auto& v : violations) out += (out.empty() ? "" : "\n") + v.message;
+  return out;
+}
+
+std::vector<std::string> configuration_names(const SubsystemSpec& spec) {
+  std::vector<std::string> names;
+  for (const auto& c : spec.configurations) names.push_back(c.name);
+  return names;
+}
+
+}  // namespace
+
+// Members in the order they are made; each refers only to those above it.
+struct Subsystem::Impl {
+  SubsystemSpec spec;  // the resolution points into this copy, which never moves
+  RunOptions options;
+  Resolution resolution;
+  std::unique_ptr<GlobalTable> table;
+  std::unique_ptr<SubsystemRequestBoard> requests;
+  std::unique_ptr<TaskSet> tasks;
+  std::unique_ptr<EventLog> events;
+  std::unique_ptr<Executive> executive;
+  std::unique_ptr<Reconfiguration> reconfiguration;
+  // Signals, switches, set and stop, one at a time; never taken by a task's thread. Queries
+  // (snapshot, events, get, the flag) do not take it: they answer while a switch is under way.
+  mutable std::mutex ops_mutex;
+  // The table's lifetime for the queries that read it without ops_mutex (get, the flag): stop()
+  // takes it to remove the table.
+  mutable std::mutex table_mutex;
+  std::atomic<bool> stopped{false};  // written under ops_mutex; read by queries on their own (seq_cst: rare, simplest)
+};
+
+Subsystem::Subsystem() : impl_(std::make_unique<Impl>()) {}
+Subsystem::~Subsystem() { stop(); }
+
+Result<std::unique_ptr<Subsystem>> Subsystem::create(const SubsystemSpec& spec, const Registry& registry,
+                                                     RunOptions options) {
+  std::unique_ptr<Subsystem> s(new Subsystem());
+  Impl& m = *s->impl_;
+  m.spec = spec;
+  m.options = std::move(options);
+  const std::string start = m.options.configuration.value_or(m.spec.start);
+  const ConfigurationSpec* start_config = m.spec.find_configuration(start);
+  if (start_config == nullptr)
+    return make_error(Errc::kNotFound, fmt::format("{}: no configuration named '{}'", spec.file, start));
+  const long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
+  for (const auto& t : m.spec.tasks)
+    if (t.cpu && *t.cpu >= ncpu)
+      return make_error(Errc::kInvalidInput, fmt::format("{}:{}: tasks.{}.cpu: cpu {} does not exist on this machine "
+                                                         "({} CPUs)",
+                                                         spec.file, t.loc.line, t.name, *t.cpu, ncpu));
+
+  m.resolution = resolve_subsystem(m.spec, registry);
+  auto violations = verify_subsystem(m.resolution, start);
+  if (!violations.empty())
+    return make_error(Errc::kIllegal, fmt::format("{}: configuration '{}' is not legal:\n{}", spec.file, start,
+                                                  join_lines(violations)));
+
+  auto table = GlobalTable::create(m.spec.name + m.options.shm_suffix, m.resolution.subsystem.variables);
+  if (!table) return table.error();
+  m.table = std::make_unique<GlobalTable>(std::move(*table));
+  // Constants known up front (the file's and the out-consts modules declare) are in the table
+  // before any init, so that an in-const reads its value whatever order tasks are spawned in.
+  for (const auto& [name, values] : m.resolution.subsystem.constant_values) {
+    if (auto v = m.table->find(name)) {
+      auto bytes = encode_values(m.table->shape(*v), values);
+      if (bytes) m.table->write(*v, bytes->data());
+    }
+  }
+
+  const ResolvedSubsystem& resolved = m.resolution.subsystem;
+  m.requests = std::make_unique<SubsystemRequestBoard>(configuration_names(m.spec), resolved.tasks.size());
+  m.tasks = std::make_unique<TaskSet>(resolved, *m.table, m.requests.get());
+  m.events = std::make_unique<EventLog>(m.tasks->size());
+  ExecutiveSetup setup;
+  setup.clock = m.options.clock;
+  setup.realtime_priorities = m.options.realtime_priorities;
+  setup.measure_cpu_time = m.options.measure_cpu_time;
+  setup.subsystem = &resolved;
+  setup.table = m.table.get();
+  setup.tasks = m.tasks->pointers();
+  setup.configuration = start_config->tasks;
+  setup.events = m.events.get();
+  m.executive = make_executive(std::move(setup));
+  m.reconfiguration =
+      std::make_unique<Reconfiguration>(resolved, start, *m.requests, *m.tasks, *m.executive, *m.table, *m.events);
+  return s;
+}
+
+Result<void> Subsystem::start() {
+  Impl& m = *impl_;
+  {
+    std::lock_guard<std::mutex> lock(m.ops_mutex);
+    if (m.stopped) return make_error(Errc::kState, "the subsystem is stopped");
+    const ConfigurationSpec* config = m.spec.find_configuration(m.reconfiguration->configuration());
+    std::vector<std::size_t> members;
+    for (const auto& name : config->tasks) members.push_back(*m.tasks->index_of(name));
+    auto abandon = [&](const Error& e) -> Result<void> {
+      for (auto it = members.rbegin(); it != members.rend(); ++it)
+        if ((*m.tasks)[*it].state() != TaskState::kNotCreated) (void)m.executive->signal(*it, Signal::kKill);
+      m.events->collect(*m.tasks);
+      return e;
+    };
+    for (const std::size_t i : members)
+      if (auto r = m.executive->signal(i, Signal::kSpawn); !r) return abandon(r.error());
+    if (auto r = m.executive->turn_on_together(members); !r) return abandon(r.error());
+    m.events->collect(*m.tasks);
+  }
+  // From now on the switches tasks ask for are carried out (by a service thread on the real clock,
+  // at the very instant on the virtual one), under the same lock as the operator's.
+  m.executive->serve(ServiceHooks{&m.requests->bell(), [this] {
+                                    Impl& self = *impl_;
+                                    std::lock_guard<std::mutex> lock(self.ops_mutex);
+                                    if (!self.stopped) self.reconfiguration->serve_requests();
+                                  }});
+  return {};
+}
+
+Result<void> Subsystem::signal(std::string_view task, Signal signal) {
+  Impl& m = *impl_;
+  std::lock_guard<std::mutex> lock(m.ops_mutex);
+  if (m.stopped) return make_error(Errc::kState, "the subsystem is stopped");
+  const auto i = m.tasks->index_of(task);
+  if (!i) return make_error(Errc::kNotFound, fmt::format("no task named '{}'", task));
+  auto r = m.executive->signal(*i, signal);
+  m.events->collect(*m.tasks);
+  return r;
+}
+
+void Subsystem::run_for(std::int64_t ns) {
+  Impl& m = *impl_;
+  if (m.stopped) return;
+  m.executive->run_for(ns);
+}
+
+Result<SwitchRecord> Subsystem::switch_to(std::string_view name, std::string_view cause) {
+  Impl& m = *impl_;
+  std::lock_guard<std::mutex> lock(m.ops_mutex);
+  if (m.stopped) return make_error(Errc::kState, "the subsystem is stopped");
+  return m.reconfiguration->switch_to(name, cause, m.executive->now_ns());
+}
+
+std::string Subsystem::configuration() const {
+  std::lock_guard<std::mutex> lock(impl_->ops_mutex);
+  return impl_->reconfiguration->configuration();
+}
+
+std::vector<SwitchRecord> Subsystem::switches() const {
+  std::lock_guard<std::mutex> lock(impl_->ops_mutex);
+  return impl_->reconfiguration->history();
+}
+
+void Subsystem::stop() {
+  Impl& m = *impl_;
+  if (!m.executive) return;  // create() failed before it existed
+  // The service thread takes ops_mutex to serve a request: stop it before taking the lock.
+  m.executive->stop_serving();
+  std::lock_guard<std::mutex> lock(m.ops_mutex);
+  if (m.stopped) return;
+  m.executive->shutdown();  // every task off, then killed; the threads end
+  m.stopped = true;
+  m.events->collect(*m.tasks);  // what off and kill reported stays readable, as do the tasks' figures
+  std::lock_guard<std::mutex> table(m.table_mutex);
+  m.table.reset();  // unlinks the shared memory
+}
+
+std::int64_t Subsystem::now_ns() const { return impl_->executive->now_ns(); }
+ClockKind Subsystem::clock() const { return impl_->executive->clock(); }
+const SubsystemSpec& Subsystem::spec() const { return impl_->spec; }
+const ResolvedSubsystem& Subsystem::resolved() const { return impl_->resolution.subsystem; }
+
+bool Subsystem::illegal_configuration() const {
+  std::lock_guard<std::mutex> lock(impl_->table_mutex);  // the table goes at stop
+  return impl_->table && impl_->table->illegal_configuration();
+}
+
+Result<std::vector<double>> Subsystem::get(std::string_view variable) const {
+  const Impl& m = *impl_;
+  std::lock_guard<std::mutex> lock(m.table_mutex);  // the table goes at stop
+  if (m.table == nullptr) return make_error(Errc::kState, "the subsystem is stopped");
+  const auto v = m.table->find(variable);
+  if (!v) return make_error(Errc::kNotFound, fmt::format("no state variable named '{}'", variable));
+  std::vector<std::byte> bytes(m.table->shape(*v).bytes());
+  const ReadOutcome r = m.table->read(*v, bytes.data(), 0);
+  if (r.freshness == Freshness::kNoData)
+    return make_error(Errc::kNotFound, fmt::format("{} has not been written yet", variable));
+  return decode_values(m.table->shape(*v), bytes.data());
+}
+
+Result<void> Subsystem::set(std::string_view variable, const std::vector<double>& values) {
+  Impl& m = *impl_;
+  std::lock_guard<std::mutex> lock(m.ops_mutex);  // no switch may turn a producer on meanwhile
+  if (m.stopped) return make_error(Errc::kState, "the subsystem is stopped");
+  const auto v = m.table->find(variable);
+  if (!v) return make_error(Errc::kNotFound, fmt::format("no state variable named '{}'", variable));
+  for (const auto& [name, value] : m.spec.constants)
+    if (name == variable) return make_error(Errc::kState, fmt::format("{} is a subsystem constant", variable));
+  for (std::size_t i = 0; i < m.tasks->size(); ++i) {
+    const Task& t = (*m.tasks)[i];
+    if (t.state() != TaskState::kOn) continue;
+    for (const auto& b : t.resolved().bindings)
+      if (!is_input(b.kind) && b.variable == variable)
+        return make_error(Errc::kState, fmt::format("{} is produced by task '{}', which is ON", variable, t.name()));
+  }
+  auto bytes = encode_values(m.table->shape(*v), values);
+  if (!bytes) return bytes.error();
+  m.table->write(*v, bytes->data());
+  m.executive->variable_written(*v);
+  return {};
+}
+
+std::vector<TaskSnapshot> Subsystem::snapshot() const {
+  Impl& m = *impl_;
+  m.events->collect(*m.tasks);  // so that last_error is current whether or not anyone drains events
+  std::vector<TaskSnapshot> out;
+  for (std::size_t i = 0; i < m.tasks->size(); ++i) {
+    const Task& t = (*m.tasks)[i];
+    out.push_back(TaskSnapshot{t.name(), t.spec().module, t.state(), t.period_ns(), m.executive->cpu_of(i),
+                               t.stats().snapshot(), m.events->last_error(i)});
+  }
+  return out;
+}
+
+std::vector<Event> Subsystem::drain_events() {
+  Impl& m = *impl_;
+  m.events->collect(*m.tasks);  // the log's own lock makes it the rings' one consumer
+  return m.events->drain();
+}
+
+GlobalTable& SubsystemTestAccess::table(Subsystem& subsystem) {
+  CHIMERA_INVARIANT(subsystem.impl_->table != nullptr, "SubsystemTestAccess::table() after stop()");
+  return *subsystem.impl_->table;
+}
+
+bool Subsystem::hard_task_failed() const { return impl_->tasks && impl_->tasks->hard_task_failed(); }
+
+}  // namespace chimera

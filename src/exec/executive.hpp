@@ -1,0 +1,112 @@
+#pragma once
+// The executive (the paper's "RTOS services", 3.3): what releases a subsystem's tasks under the
+// file's policy, carries out the paper's signals between their cycles and commits switches at a
+// cycle boundary. One interface, two clocks: the real executive (real-time threads on
+// CLOCK_MONOTONIC) and the virtual one (a discrete-event simulation of the same schedule, the
+// tests' oracle), both following release_policy.hpp. The subsystem, the reconfiguration and the
+// control talk only to this interface, and none of them chooses a clock: make_executive() does,
+// once. Tasks whose modules run in another process are to be one more implementation behind it.
+//
+// Exported to the parts above. Nothing here is real-time safe: none of it runs in a cycle.
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "chimera/config/verify.hpp"
+#include "chimera/core/result.hpp"
+#include "chimera/exec/clock.hpp"
+#include "chimera/lifecycle/state.hpp"
+#include "chimera/svt/global_table.hpp"
+#include "doorbell.hpp"
+#include "event_log.hpp"
+#include "task.hpp"
+
+namespace chimera {
+
+/// What an executive is made from.
+struct ExecutiveSetup {
+  ClockKind clock = ClockKind::kReal;
+  /// Real clock: SCHED_FIFO and mlockall where the system allows them (one warning where not).
+  bool realtime_priorities = true;
+  /// Real clock: every task's execution time as its thread's CPU time (profiling), not only that
+  /// of tasks with a wcet budget. Costs two system calls a cycle.
+  bool measure_cpu_time = false;
+  const ResolvedSubsystem* subsystem = nullptr;
+  GlobalTable* table = nullptr;
+  std::vector<Task*> tasks;                // every task of the file, in file order
+  std::vector<std::string> configuration;  // the tasks that start: the first plan (MUF's critical set)
+  EventLog* events = nullptr;              // where the executive's own events go (a job overdue)
+};
+
+/// A switch's commit (docs/reconfiguration.md).
+struct SwitchCommit {
+  std::vector<std::size_t> leaving;  // ON now: off after their last release before the commit
+  std::vector<std::size_t> joining;  // OFF now: on at the commit, released from it
+  /// The switch created tasks, so it takes longer than a cycle: on the virtual clock the old
+  /// configuration runs on to the next boundary first (the real clock simply took that long).
+  bool slow = false;
+  std::vector<std::string> target;  // the target configuration's tasks: the plan from the commit on
+};
+
+/// What the subsystem interface asks the executive to serve while it runs.
+struct ServiceHooks {
+  Doorbell* requests = nullptr;          // rings when a module asks for a switch (rung to stop, too)
+  std::function<void()> serve_requests;  // carries out (or refuses) the requests; takes the interface's locks
+};
+
+class Executive {
+ public:
+  Executive() = default;
+  Executive(const Executive&) = delete;
+  Executive& operator=(const Executive&) = delete;
+  Executive(Executive&&) = delete;
+  Executive& operator=(Executive&&) = delete;
+  virtual ~Executive() = default;
+
+  [[nodiscard]] virtual ClockKind clock() const noexcept = 0;
+  /// Time since start on this executive's clock (after shutdown(): when it stopped).
+  [[nodiscard]] virtual std::int64_t now_ns() const = 0;
+  /// The CPU task `task` runs on (pinned by the file or assigned); it never changes. Any thread.
+  [[nodiscard]] virtual int cpu_of(std::size_t task) const = 0;
+
+  /// Carries out a lifecycle signal on one task, between its cycles, and returns once it is done.
+  /// A signal the task's state does not allow is refused and changes nothing.
+  virtual Result<void> signal(std::size_t task, Signal signal) = 0;
+  /// Turns on the tasks `tasks` (OFF) as one: on() on each, then every one's first release at its
+  /// first grid point at or after one common instant, so that none runs before all are on.
+  virtual Result<void> turn_on_together(const std::vector<std::size_t>& tasks) = 0;
+  /// A switch's commit at one cycle boundary of the fastest task involved: the leaving tasks off
+  /// after their last release before it, the joining ones on and released from it, the others
+  /// untouched; then the plan of `commit.target`.
+  virtual Result<void> commit_switch(const SwitchCommit& commit) = 0;
+  /// reinit() of task `task` between two of its cycles.
+  virtual Result<void> reinit(std::size_t task) = 0;
+  /// Lets the subsystem run for `ns`: simulated time on the virtual clock (the requests of
+  /// ServiceHooks served at the very instant they are asked for), a sleep on the real one.
+  virtual void run_for(std::int64_t ns) = 0;
+  /// From now on serves `hooks`: the real clock with a service thread (which also watches for
+  /// jobs running past their deadline), the virtual one inside run_for.
+  virtual void serve(ServiceHooks hooks) = 0;
+  /// Stops serving (the real clock's service thread ends) and returns once nothing of the hooks
+  /// runs any more. Idempotent.
+  virtual void stop_serving() = 0;
+  /// Someone other than a task (the operator's `set`) wrote variable `v`: wakes its readers that
+  /// are triggered by it.
+  virtual void variable_written(VarIndex v) = 0;
+  /// Stops serving, turns every task off, then kills it, and ends every thread. Idempotent. The
+  /// tasks keep their figures and events; no signal may follow.
+  virtual void shutdown() = 0;
+};
+
+/// The shortest period among the periodic tasks that leave or join in `commit` (0: none): a
+/// switch commits at one of its boundaries.
+std::int64_t shortest_period(const std::vector<Task*>& tasks, const SwitchCommit& commit);
+
+/// The executive of `setup.clock`. Not real-time safe.
+std::unique_ptr<Executive> make_executive(ExecutiveSetup setup);
+
+}  // namespace chimera

@@ -1,0 +1,73 @@
+#pragma once
+// The release policy, written once: plain functions of time that both executives call, the real
+// one with CLOCK_MONOTONIC times, the virtual one with simulated times, so that the virtual
+// clock stays an oracle for the real one (docs/scheduling.md). Each is tested on its own in
+// tests/unit/exec/release_policy_test.cpp. All are real-time safe.
+//
+//   the grid          periodic releases at whole multiples of the period, from time 0
+//   late releases     what a task that comes back late does with the releases that passed
+//   the same-rate     when a consumer waits for a producer of the same period, and how long
+//   rule
+//   a switch's        the cycle boundary a commit goes at
+//   commit
+// The sporadic server's budget is sporadic_server.hpp; a task's trigger variable is the Task's.
+
+#include <algorithm>
+#include <cstdint>
+
+#include "chimera/config/subsystem.hpp"
+
+namespace chimera::release_policy {
+
+/// The index k of the first release k * period at or after `t` (t >= 0, period > 0): where a task
+/// turning on at `t` joins the grid.
+constexpr std::int64_t first_release_index(std::int64_t t, std::int64_t period) noexcept {
+  return (t + period - 1) / period;
+}
+
+/// The first grid point of `period` strictly after `t`: the cycle boundary a switch commits at
+/// (t is now plus the time the commit needs to be posted, on the real clock).
+constexpr std::int64_t next_boundary_after(std::int64_t t, std::int64_t period) noexcept {
+  return (t / period + 1) * period;
+}
+
+/// What a task whose next release is at `next_release` does, finding itself at `now`.
+struct LateReleases {
+  std::uint64_t skipped = 0;      // releases it does not run, each a missed deadline
+  std::int64_t next_release = 0;  // the release it runs next (later than now if all passed)
+};
+
+/// Under `late: skip`, the releases whose absolute deadline has already passed are not worth
+/// starting: they are skipped, and the task goes on at the first whose deadline is still ahead.
+/// Under `late: run` nothing is skipped: the late releases run one after another, late, and the
+/// grid holds. `relative_deadline` 0 means none (nothing is ever skipped). Times in one unit.
+constexpr LateReleases late_releases(LatePolicy late, std::int64_t next_release, std::int64_t now, std::int64_t period,
+                                     std::int64_t relative_deadline) noexcept {
+  if (late != LatePolicy::kSkip || relative_deadline <= 0) return {0, next_release};
+  // The releases r = next_release + j * period with r + relative_deadline < now, counted at once
+  // (a loop would take as long as the stall divided by the period).
+  const std::int64_t past = now - relative_deadline - next_release;
+  if (past <= 0) return {0, next_release};
+  const std::int64_t n = (past + period - 1) / period;
+  return {static_cast<std::uint64_t>(n), next_release + n * period};
+}
+
+/// The same-rate rule (release_order.hpp): a consumer's job of release `release` waits for a
+/// same-period producer that is ON (or joining at or before that release), has not completed
+/// that release, and will run it: its next release to run is at or before it. A producer that
+/// turned on later, or skipped that release, is not waited for. Releases in one unit (index or ns).
+constexpr bool waits_for_producer(bool producer_on, bool producer_completed_it, std::int64_t producer_next,
+                                  std::int64_t release) noexcept {
+  return producer_on && !producer_completed_it && producer_next >= 0 && producer_next <= release;
+}
+
+/// How long at most a consumer waits for its producers: until half its relative deadline after
+/// the wait starts (or after the release, if it starts before it). Counted from the start of the
+/// wait so that, when tasks catch up after a stall and every release is already in the past, the
+/// order still holds; bounded so that a stuck producer cannot hold a consumer hostage.
+constexpr std::int64_t producer_wait_until(std::int64_t release, std::int64_t wait_start,
+                                           std::int64_t relative_deadline) noexcept {
+  return std::max(release, wait_start) + relative_deadline / 2;
+}
+
+}  // namespace chimera::release_policy
