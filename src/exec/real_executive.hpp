@@ -40,10 +40,10 @@ class RealExecutive final : public Executive {
   [[nodiscard]] ClockKind clock() const noexcept override { return ClockKind::kReal; }
   [[nodiscard]] std::int64_t now_ns() const override;
   [[nodiscard]] int cpu_of(std::size_t task) const override { return cpus_[task]; }
-  Result<void> signal(std::size_t task, Signal sig) override;
-  Result<void> turn_on_together(const std::vector<std::size_t>& tasks) override;
+  Result<void> signal(std::size_t index, Signal sig) override;
+  Result<void> turn_on_together(const std::vector<std::size_t>& indices) override;
   Result<void> commit_switch(const SwitchCommit& commit) override;
-  Result<void> reinit(std::size_t task) override;
+  Result<void> reinit(std::size_t index) override;
   void run_for(std::int64_t ns) override;
   void serve(ServiceHooks hooks) override;
   void stop_serving() override;
@@ -53,11 +53,11 @@ class RealExecutive final : public Executive {
   /// CLOCK_MONOTONIC at the executive's time 0. Real-time safe.
   [[nodiscard]] std::int64_t epoch_ns() const noexcept { return epoch_ns_; }
   [[nodiscard]] const GlobalTable& table() const { return *table_; }
-  /// The SCHED_FIFO priority task `task` starts at (its fixed priority under rm and dm).
-  [[nodiscard]] int fixed_priority(std::size_t task) const;
-  /// The absolute deadline (executive clock) of the job task `task` is running now, if it is
+  /// The SCHED_FIFO priority task `index` starts at (its fixed priority under rm and dm).
+  [[nodiscard]] int fixed_priority(std::size_t index) const;
+  /// The absolute deadline (executive clock) of the job task `index` is running now, if it is
   /// running one with a deadline; it names the job. Any thread; wait-free.
-  [[nodiscard]] std::optional<std::int64_t> running_deadline(std::size_t task) const noexcept;
+  [[nodiscard]] std::optional<std::int64_t> running_deadline(std::size_t index) const noexcept;
 
   /// How often the service thread looks for jobs running past their deadline.
   static constexpr std::int64_t kWatchTickNs = 5'000'000;
@@ -78,7 +78,7 @@ class RealExecutive final : public Executive {
   /// New urgency data (MUF's critical set after a switch) for the edf / muf dispatchers.
   void set_plan(SchedulePlan plan);
   /// The service thread's body, and one look at every task's running job (service_thread.cpp).
-  void service_main(ServiceHooks hooks);
+  void service_main(const ServiceHooks& hooks);
   void watch_overruns();
 
   const ResolvedSubsystem& subsystem_;

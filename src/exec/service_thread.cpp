@@ -22,7 +22,7 @@ void RealExecutive::serve(ServiceHooks hooks) {
   if (service_.joinable()) return;
   service_bell_ = hooks.requests != nullptr ? hooks.requests : &own_bell_;
   service_stop_.store(false, std::memory_order_relaxed);  // before the thread exists
-  service_ = std::thread([this, hooks = std::move(hooks)]() mutable { service_main(std::move(hooks)); });
+  service_ = std::thread([this, hooks = std::move(hooks)] { service_main(hooks); });
 }
 
 void RealExecutive::stop_serving() {
@@ -32,7 +32,7 @@ void RealExecutive::stop_serving() {
   service_.join();
 }
 
-void RealExecutive::service_main(ServiceHooks hooks) {
+void RealExecutive::service_main(const ServiceHooks& hooks) {
   const Doorbell& bell = *service_bell_;
   std::uint32_t seen = bell.rung();
   if (hooks.serve_requests) hooks.serve_requests();  // anything asked before the thread started

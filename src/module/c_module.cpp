@@ -70,9 +70,9 @@ const void* object_of(const void* p) {
   return info.dli_fbase;
 }
 
-// NOLINTNEXTLINE(cppcoreguidelines-pro-type-reinterpret-cast): a function's address, for dladdr only
 template <class F>
 const void* address_of(F* f) {
+  // NOLINTNEXTLINE(cppcoreguidelines-pro-type-reinterpret-cast): a function's address, for dladdr only
   return reinterpret_cast<const void*>(f);
 }
 

@@ -117,7 +117,9 @@ TEST(FlagRace, TasksFailingOnTheirThreadsWhileSwitchesCommitNeverLoseTheFlag) {
   for (int i = 0; i < 150; ++i) {
     const std::string target = s->configuration() == "with_a" ? "with_b" : "with_a";
     const std::string joining = target == "with_a" ? "a" : "b";
-    if (state_of(*s, joining) == TaskState::kError) ASSERT_TRUE(s->signal(joining, Signal::kClear).ok());
+    if (state_of(*s, joining) == TaskState::kError) {
+      ASSERT_TRUE(s->signal(joining, Signal::kClear).ok());
+    }
     auto r = s->switch_to(target);
     ASSERT_TRUE(r.ok()) << r.error().message;
     // Right after the commit, while the joining task's first cycles run (and fail) on its thread.
@@ -131,8 +133,11 @@ TEST(FlagRace, TasksFailingOnTheirThreadsWhileSwitchesCommitNeverLoseTheFlag) {
     }
   }
   EXPECT_GT(seen_in_error, 100) << "the failures never overlapped the switches: the test proved nothing";
-  for (const char* t : {"a", "b"})
-    if (state_of(*s, t) == TaskState::kError) ASSERT_TRUE(s->signal(t, Signal::kClear).ok());
+  for (const char* t : {"a", "b"}) {
+    if (state_of(*s, t) == TaskState::kError) {
+      ASSERT_TRUE(s->signal(t, Signal::kClear).ok());
+    }
+  }
   EXPECT_FALSE(s->illegal_configuration()) << "nothing holds it any more";
 }
 
