@@ -1,10 +1,11 @@
-// chimera analyze FILE [--config NAME] [--wcet-from PROFILE] [--overhead DURATION]:
-// schedulability per CPU under the file's scheduler (contract section 2, docs/scheduling.md).
+// chimera analyze FILE [--config NAME] [--wcet-from PROFILE] [--overhead DURATION] [--json]:
+// schedulability per CPU under the file's scheduler (contract sections 2 and 4, docs/scheduling.md).
 
 #include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -13,6 +14,7 @@
 
 #include "chimera/analysis/cpu_assignment.hpp"
 #include "chimera/analysis/report.hpp"
+#include "chimera/analysis/report_json.hpp"
 #include "chimera/analysis/schedulability.hpp"
 #include "chimera/analysis/task_models.hpp"
 #include "chimera/analysis/wcet_profile.hpp"
@@ -48,13 +50,10 @@ bool legal(const SubsystemSpec& spec, const std::optional<std::string>& config) 
   return false;
 }
 
-struct Analysed {
-  bool ok = true;  // false: it could not be analysed (the message is printed)
-  bool feasible = false;
-};
-
-Analysed analyse_one(const SubsystemSpec& spec, const ConfigurationSpec& config, const WcetProfile* profile,
-                     const analysis::AnalysisOptions& options) {
+// nullopt: the configuration could not be analysed (the message is printed on stderr).
+std::optional<analysis::AnalysedConfiguration> analyse_one(const SubsystemSpec& spec, const ConfigurationSpec& config,
+                                                           const WcetProfile* profile,
+                                                           const analysis::AnalysisOptions& options) {
   // The CPUs come from what `chimera run` knows too (the file's wcet: and cpu:), so that the
   // assignment shown is the one a run makes; profile and measurements only refine the analysis.
   const auto cpus = analysis::allowed_cpus(spec, static_cast<int>(::sysconf(_SC_NPROCESSORS_ONLN)));
@@ -68,7 +67,7 @@ Analysed analyse_one(const SubsystemSpec& spec, const ConfigurationSpec& config,
     if (!run) {
       fmt::print(stderr, "{}: configuration '{}': cannot run it to measure execution times: {}\n", spec.file,
                  config.name, run.error().message);
-      return Analysed{false, false};
+      return std::nullopt;
     }
     measured = *std::move(run);
     note = fmt::format(
@@ -80,10 +79,10 @@ Analysed analyse_one(const SubsystemSpec& spec, const ConfigurationSpec& config,
   std::vector<int> cpu_of;
   cpu_of.reserve(models.size());
   for (const auto& m : models) cpu_of.push_back(file_cpu[static_cast<std::size_t>(m.file_index)]);
-  const auto result = analysis::analyse_configuration(models, cpu_of, cpus, spec.scheduler, options);
-  const analysis::ReportContext context{spec.file, config.name, spec.scheduler, options, note};
-  std::fputs(analysis::format_report(context, models, result).c_str(), stdout);
-  return Analysed{true, result.feasible};
+  auto result = analysis::analyse_configuration(models, cpu_of, cpus, spec.scheduler, options);
+  return analysis::AnalysedConfiguration{
+      analysis::ReportContext{spec.file, config.name, spec.scheduler, options, std::move(note)}, models,
+      std::move(result)};
 }
 
 }  // namespace
@@ -104,6 +103,7 @@ CLI::App* add_analyze_command(CLI::App& app, AnalyzeArgs& args) {
         args.overhead_ns = *ns;
       },
       "framework overhead added to every C, per cycle (default 1us)");
+  cmd->add_flag("--json", args.json, "print the analysis as one JSON document (docs/scheduling.md)");
   return cmd;
 }
 
@@ -125,15 +125,25 @@ int analyze_command(const AnalyzeArgs& args) {
   if (!legal(*spec, args.config)) return kExitInvalid;
 
   const analysis::AnalysisOptions options{.overhead_ns = args.overhead_ns};
-  std::size_t analysed = 0;
+  // JSON is printed whole at the end, so that stdout holds one complete document or, when a
+  // configuration cannot be analysed, nothing; the text goes out as each configuration is done.
+  std::vector<analysis::AnalysedConfiguration> results;
   std::size_t infeasible = 0;
   for (const auto& config : spec->configurations) {
     if (args.config && config.name != *args.config) continue;
-    if (analysed > 0) std::fputs("\n", stdout);
-    const Analysed a = analyse_one(*spec, config, profile ? &*profile : nullptr, options);
-    if (!a.ok) return kExitInvalid;
-    ++analysed;
-    infeasible += a.feasible ? 0 : 1;
+    auto a = analyse_one(*spec, config, profile ? &*profile : nullptr, options);
+    if (!a) return kExitInvalid;
+    infeasible += a->result.feasible ? 0 : 1;
+    if (!args.json) {
+      if (!results.empty()) std::fputs("\n", stdout);
+      std::fputs(analysis::format_report(a->context, a->tasks, a->result).c_str(), stdout);
+    }
+    results.push_back(*std::move(a));
+  }
+  const std::size_t analysed = results.size();
+  if (args.json) {
+    std::fputs(analysis::analysis_json(args.file, results).c_str(), stdout);
+    return infeasible == 0 ? kExitOk : kExitFailed;
   }
   if (infeasible == 0) {
     fmt::print("{}: {} configuration{} feasible\n", args.file, analysed, analysed == 1 ? "" : "s");

@@ -37,10 +37,12 @@ struct AnalyzeArgs {
   std::optional<std::string> config;
   std::optional<std::string> wcet_from;
   std::int64_t overhead_ns = analysis::kDefaultOverheadNs;
+  bool json = false;  // one JSON document on stdout instead of the text report
 };
 /// Declares `chimera analyze` and its options on `app`; parsing fills `args`.
 CLI::App* add_analyze_command(CLI::App& app, AnalyzeArgs& args);
-/// `chimera analyze FILE [--config NAME] [--wcet-from PROFILE] [--overhead DURATION]`; returns the exit code.
+/// `chimera analyze FILE [--config NAME] [--wcet-from PROFILE] [--overhead DURATION] [--json]`; returns the
+/// exit code.
 int analyze_command(const AnalyzeArgs& args);
 
 struct ProfileArgs {

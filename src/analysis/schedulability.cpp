@@ -106,6 +106,7 @@ void analyse_fixed_priority(std::span<const TaskModel> tasks, const std::vector<
     } else {
       const ResponseTime rt = response_time(*r.demand, interference);
       if (rt.outcome == RtaOutcome::kMeets || rt.outcome == RtaOutcome::kMisses) r.response_ns = rt.response_ns;
+      r.response_is_lower_bound = rt.outcome == RtaOutcome::kMisses && !rt.exact;
       r.verdict = rt.outcome == RtaOutcome::kMeets ? Verdict::kMeets : Verdict::kCanMiss;
       r.reason = rta_reason(rt, *r.demand);
     }

@@ -48,6 +48,9 @@ struct TaskResult {
   /// deadline). edf, muf: the deadline, an upper bound (response_is_bound). 0: none.
   std::int64_t response_ns = 0;
   bool response_is_bound = false;
+  /// rm, dm: response_ns is the latest completion found before the analysis gave up, already
+  /// past the deadline, so the true worst case is at least that (the reason says "at least").
+  bool response_is_lower_bound = false;
   bool critical = false;  // muf: in the critical set
   std::string reason;     // one line; empty when the task meets its deadline by the CPU's test
 };
