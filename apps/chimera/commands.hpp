@@ -28,6 +28,7 @@ struct RunArgs {
   std::optional<std::int64_t> for_ns;
   ClockKind clock = ClockKind::kReal;
   std::optional<std::string> stats_json;
+  bool rt_check = false;  // count allocations in the tasks' real-time methods
 };
 /// `chimera run FILE ...`; returns the exit code.
 int run_command(const RunArgs& args);

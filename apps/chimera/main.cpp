@@ -66,6 +66,8 @@ int run_main(int argc, char** argv) {
       ->check(CLI::IsMember({"real", "virtual"}))
       ->capture_default_str();
   auto* run_stats_opt = run_cmd->add_option("--stats-json", run_stats, "write per-task timing figures here at exit");
+  run_cmd->add_flag("--rt-check", run.rt_check,
+                    "count allocations inside each task's on/cycle/off/sync (rt violations in the timing table)");
 
   chimera::cli::AnalyzeArgs analyze;
   auto* analyze_cmd = chimera::cli::add_analyze_command(app, analyze);

@@ -1,4 +1,5 @@
-// chimera run FILE [--config NAME] [--for DURATION] [--clock real|virtual] [--stats-json FILE]:
+// chimera run FILE [--config NAME] [--for DURATION] [--clock real|virtual] [--stats-json FILE]
+// [--rt-check]:
 // starts the subsystem, takes commands from a shell or a script on stdin, stops it cleanly.
 
 #include <unistd.h>
@@ -23,6 +24,7 @@
 #include "exit_codes.hpp"
 #include "line_reader.hpp"
 #include "load_file.hpp"
+#include "rt_check_allocator.hpp"
 #include "stop_request.hpp"
 
 namespace chimera::cli {
@@ -157,6 +159,9 @@ int run_command(const RunArgs& args) {
   RunOptions options;
   options.clock = args.clock;
   options.configuration = args.config;
+  options.rt_check = args.rt_check;
+  if (args.rt_check && !kRtCheckAllocator)
+    fmt::print(stderr, "--rt-check: this build's allocator belongs to a sanitizer; nothing will be counted\n");
   auto created = Subsystem::create(*spec, registry, options);
   if (!created) {
     fmt::print(stderr, "{}\n", created.error().message);
@@ -184,11 +189,11 @@ int run_command(const RunArgs& args) {
   subsystem.stop();
   Control control(subsystem);
   out(control.drain_events());
-  out(timing_table(tasks));
+  out(timing_table(tasks, args.rt_check));
 
   int code = subsystem.hard_task_failed() ? kExitFailed : kExitOk;
   if (args.stats_json) {
-    if (auto written = write_stats_json(*args.stats_json, tasks, args.clock, switches); !written) {
+    if (auto written = write_stats_json(*args.stats_json, tasks, args.clock, switches, args.rt_check); !written) {
       fmt::print(stderr, "{}\n", written.error().message);
       code = std::max(code, kExitFailed);
     }

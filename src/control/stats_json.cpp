@@ -9,7 +9,7 @@
 
 namespace chimera {
 
-std::string stats_json(std::span<const TaskSnapshot> tasks, ClockKind clock, std::uint64_t switches) {
+std::string stats_json(std::span<const TaskSnapshot> tasks, ClockKind clock, std::uint64_t switches, bool rt_check) {
   // ordered_json keeps the tasks in file order, which is how people read them.
   using Json = nlohmann::ordered_json;
   Json per_task = Json::object();
@@ -30,6 +30,7 @@ std::string stats_json(std::span<const TaskSnapshot> tasks, ClockKind clock, std
         {"overruns", s.overruns},
         {"skipped", s.skipped},
         {"order_timeouts", s.order_timeouts},
+        {"rt_violations", s.rt_violations},  // allocations in on/cycle/off/sync; counted only with rt_check
         {"exec_ns",
          Json{{"mean", s.exec_mean_ns}, {"p50", s.exec_p50_ns}, {"p99", s.exec_p99_ns}, {"max", s.exec_max_ns}}},
         {"latency_ns", Json{{"p50", s.latency_p50_ns}, {"p99", s.latency_p99_ns}, {"max", s.latency_max_ns}}},
@@ -41,17 +42,18 @@ std::string stats_json(std::span<const TaskSnapshot> tasks, ClockKind clock, std
   const Json doc{
       {"clock", clock == ClockKind::kVirtual ? "virtual" : "real"},
       {"switches", switches},
+      {"rt_check", rt_check},
       {"tasks", std::move(per_task)},
   };
   return doc.dump(2) + "\n";
 }
 
 Result<void> write_stats_json(const std::string& path, std::span<const TaskSnapshot> tasks, ClockKind clock,
-                              std::uint64_t switches) {
+                              std::uint64_t switches, bool rt_check) {
   std::ofstream out(path, std::ios::trunc);
   if (!out)
     return make_error(Errc::kSystem, fmt::format("{}: cannot write: {}", path, std::generic_category().message(errno)));
-  out << stats_json(tasks, clock, switches);
+  out << stats_json(tasks, clock, switches, rt_check);
   out.close();
   if (!out) return make_error(Errc::kSystem, fmt::format("{}: write failed", path));
   return {};

@@ -100,6 +100,7 @@ Result<std::unique_ptr<Subsystem>> Subsystem::create(const SubsystemSpec& spec, 
   m.requests = std::make_unique<SubsystemRequestBoard>(configuration_names(m.spec), resolved.tasks.size());
   m.tasks = std::make_unique<TaskSet>(resolved, *m.table, m.requests.get());
   m.events = std::make_unique<EventLog>(m.tasks->size());
+  for (Task* t : m.tasks->pointers()) t->set_rt_check(m.options.rt_check);
   ExecutiveSetup setup;
   setup.clock = m.options.clock;
   setup.realtime_priorities = m.options.realtime_priorities;

@@ -45,17 +45,21 @@ std::string status_table(std::span<const TaskSnapshot> tasks) {
   return table.render();
 }
 
-std::string timing_table(std::span<const TaskSnapshot> tasks) {
+std::string timing_table(std::span<const TaskSnapshot> tasks, bool rt_check) {
   // Timing failures other than late cycles get columns only when some task has them.
   bool overruns = false;
   bool skipped = false;
+  // With --rt-check a column of zeros is the answer the author wants, so it shows either way.
+  bool rt_violations = rt_check;
   for (const auto& t : tasks) {
     overruns = overruns || t.stats.overruns != 0;
     skipped = skipped || t.stats.skipped != 0;
+    rt_violations = rt_violations || t.stats.rt_violations != 0;
   }
   auto columns = identity_columns();
   if (overruns) columns.push_back({"overruns", Align::kRight});
   if (skipped) columns.push_back({"skipped", Align::kRight});
+  if (rt_violations) columns.push_back({"rt violations", Align::kRight});
   for (const char* header : {"exec mean", "exec max", "latency p50", "latency p99", "latency max"})
     columns.push_back({header, Align::kRight});
   TextTable table(std::move(columns));
@@ -64,6 +68,7 @@ std::string timing_table(std::span<const TaskSnapshot> tasks) {
     const auto& s = t.stats;
     if (overruns) cells.push_back(fmt::format("{}", s.overruns));
     if (skipped) cells.push_back(fmt::format("{}", s.skipped));
+    if (rt_violations) cells.push_back(fmt::format("{}", s.rt_violations));
     // A task that never cycled has no figures; a dash says so better than "0 ns".
     auto figure = [&](std::int64_t ns) { return s.cycles == 0 ? std::string("-") : format_duration(ns); };
     for (std::int64_t ns : {s.exec_mean_ns, s.exec_max_ns, s.latency_p50_ns, s.latency_p99_ns, s.latency_max_ns})

@@ -89,6 +89,12 @@ void TaskStats::record_skipped(std::uint64_t n) noexcept {
 
 void TaskStats::record_order_timeout() noexcept { bump(order_timeouts_); }
 
+bool TaskStats::record_rt_allocation() noexcept {
+  const std::uint64_t before = rt_allocations_.load(std::memory_order_relaxed);  // single writer, as bump()
+  bump(rt_allocations_);
+  return before == 0;
+}
+
 TaskStatsSnapshot TaskStats::snapshot() const {
   TaskStatsSnapshot s;
   s.cycles = cycles_.load(std::memory_order_relaxed);  // figures may be one cycle apart: fine for a table
@@ -108,6 +114,7 @@ TaskStatsSnapshot TaskStats::snapshot() const {
   s.exec_histogram = exec_.nonempty_buckets();
   s.latency_histogram = latency_.nonempty_buckets();
   s.order_timeouts = order_timeouts_.load(std::memory_order_relaxed);
+  s.rt_violations = rt_allocations_.load(std::memory_order_relaxed);
   return s;
 }
 
@@ -120,6 +127,7 @@ void TaskStats::reset() noexcept {
   overruns_.store(0, std::memory_order_relaxed);
   skipped_.store(0, std::memory_order_relaxed);
   order_timeouts_.store(0, std::memory_order_relaxed);
+  rt_allocations_.store(0, std::memory_order_relaxed);
   exec_sum_ns_.store(0, std::memory_order_relaxed);
   exec_max_ns_.store(0, std::memory_order_relaxed);
 }

@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "chimera/exec/clock.hpp"
+#include "rt_check_scope.hpp"
 
 namespace chimera {
 
@@ -37,6 +38,22 @@ Task::~Task() {
 }
 
 Status Task::call_raw(Hook hook) noexcept {
+  // The methods the template says must not allocate; init, kill, reinit, error and clear may.
+  const bool real_time = hook == Hook::kOn || hook == Hook::kCycle || hook == Hook::kOff || hook == Hook::kSync;
+  if (!rt_check_ || !real_time) return dispatch(hook);
+  rt_hook_ = hook;
+  const RtCheckScope scope(*this);
+  return dispatch(hook);
+}
+
+void Task::note_rt_allocation() noexcept {
+  // Once per task: a cycle that allocates does so every cycle, and the count tells the rest.
+  if (stats_.record_rt_allocation())
+    events_.push(timing_.release_ns, hook_name(static_cast<std::uint8_t>(rt_hook_)),
+                 "() allocated on the real-time path (--rt-check)");
+}
+
+Status Task::dispatch(Hook hook) noexcept {
   try {
     switch (hook) {
       case Hook::kOn: return module_->on();

@@ -102,6 +102,12 @@ class Task {
   /// Whether spawn publishes what init produced (false for a task created in the background of a
   /// running configuration, which may hold other producers of its outputs). Set before spawn.
   void set_publish_at_spawn(bool publish) noexcept { publish_at_spawn_ = publish; }
+  /// --rt-check: count what on(), cycle(), off() and sync() do that the real-time path must not
+  /// (set before spawn). Off, the methods run as they always do, behind one branch.
+  void set_rt_check(bool on) noexcept { rt_check_ = on; }
+  /// An allocation while one of its real-time methods ran on this thread (the allocator hook
+  /// calls it): counted; the first also tells the operator which method. Real-time safe.
+  void note_rt_allocation() noexcept;
   /// Where its module's switch requests go, and its index there (set before spawn).
   void set_request_board(RequestBoard* board, int index) noexcept { services_ = {board, index}; }
 
@@ -127,6 +133,7 @@ class Task {
   /// failed Status whose reason lives in exception_text_. Real-time safe for the framework.
   Status call(Hook hook) noexcept;
   Status call_raw(Hook hook) noexcept;
+  Status dispatch(Hook hook) noexcept;
   /// The paper's error rule after `hook` failed with `failure`: error() may recover (true);
   /// otherwise the task enters ERROR (false). Real-time safe.
   bool recover(Hook hook, Status failure, std::int64_t now_ns) noexcept;
@@ -150,6 +157,8 @@ class Task {
   ExecClock exec_clock_ = ExecClock::kWall;
   bool virtual_clock_ = false;
   bool publish_at_spawn_ = true;
+  bool rt_check_ = false;
+  Hook rt_hook_ = Hook::kCycle;  // the real-time method running under --rt-check, for the event
   struct Job {
     bool open = false;
     bool failed = false;          // the error path already ran (and published)

@@ -13,11 +13,13 @@ namespace chimera {
 
 /// {"clock": "real"|"virtual", "switches": N, "tasks": {"<task>": {"module", "state",
 /// "period_ns", "cycles", "missed", "exec_ns": {"mean", "max"}, "latency_ns": {"p50", "p99",
-/// "max"}}}}, tasks in the order given. Not real-time safe.
-std::string stats_json(std::span<const TaskSnapshot> tasks, ClockKind clock, std::uint64_t switches);
+/// "max"}, "rt_violations"}}, "rt_check": whether rt_violations were counted}, tasks in the
+/// order given. Not real-time safe.
+std::string stats_json(std::span<const TaskSnapshot> tasks, ClockKind clock, std::uint64_t switches,
+                       bool rt_check = false);
 
 /// Writes stats_json() to `path`; an unwritable path is an Errc::kSystem error naming it.
 Result<void> write_stats_json(const std::string& path, std::span<const TaskSnapshot> tasks, ClockKind clock,
-                              std::uint64_t switches);
+                              std::uint64_t switches, bool rt_check = false);
 
 }  // namespace chimera

@@ -34,6 +34,10 @@ struct RunOptions {
   /// Real clock: measure every task's execution time as its thread's CPU time (profiling), not
   /// only that of tasks with a wcet budget. Costs two system calls a cycle.
   bool measure_cpu_time = false;
+  /// Count allocations inside each task's on(), cycle(), off() and sync() (`chimera run
+  /// --rt-check`). Only a program that installs the allocator hook of chimera/exec/rt_check.hpp
+  /// sees any: the chimera command does; elsewhere the counts stay 0.
+  bool rt_check = false;
 };
 
 /// One task as the subsystem interface sees it.

@@ -13,8 +13,9 @@ namespace chimera {
 /// Columns task, module, state, period, cycles, missed (and the last error when a task has one).
 /// Lines end in '\n'. Not real-time safe.
 std::string status_table(std::span<const TaskSnapshot> tasks);
-/// Columns task, module, state, period, cycles, missed, exec mean/max, latency p50/p99/max.
+/// Columns task, module, state, period, cycles, missed, exec mean/max, latency p50/p99/max; an
+/// "rt violations" column when `rt_check` (the run counted them) or when any task has some.
 /// Lines end in '\n'. Not real-time safe.
-std::string timing_table(std::span<const TaskSnapshot> tasks);
+std::string timing_table(std::span<const TaskSnapshot> tasks, bool rt_check = false);
 
 }  // namespace chimera

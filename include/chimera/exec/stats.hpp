@@ -59,6 +59,9 @@ struct TaskStatsSnapshot {
   /// Cycles that started without a same-rate producer's value of the same release because the
   /// producer kept them waiting past the bound (real clock only; see docs/architecture.md).
   std::uint64_t order_timeouts = 0;
+  /// --rt-check: allocations made inside the task's on(), cycle(), off() and sync() (0 without
+  /// the check, which counts nothing).
+  std::uint64_t rt_violations = 0;
 };
 
 /// Everything the framework counts for one task. Written only by the task's thread.
@@ -71,6 +74,8 @@ class TaskStats {
   void record_skipped(std::uint64_t n) noexcept;
   /// A precedence wait gave up. Real-time safe.
   void record_order_timeout() noexcept;
+  /// An allocation on the real-time path (--rt-check); true for the first one. Real-time safe.
+  bool record_rt_allocation() noexcept;
   /// A copy of every figure, histograms included (it allocates). Not real-time safe.
   [[nodiscard]] TaskStatsSnapshot snapshot() const;
   void reset() noexcept;
@@ -84,6 +89,7 @@ class TaskStats {
   std::atomic<std::uint64_t> overruns_{0};
   std::atomic<std::uint64_t> skipped_{0};
   std::atomic<std::uint64_t> order_timeouts_{0};
+  std::atomic<std::uint64_t> rt_allocations_{0};
   std::atomic<std::int64_t> exec_sum_ns_{0};
   std::atomic<std::int64_t> exec_max_ns_{0};
 };

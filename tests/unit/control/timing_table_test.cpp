@@ -83,6 +83,29 @@ TEST(TimingTable, HumanUnitsAndDashesForTasksThatNeverRan) {
   EXPECT_EQ(display_width(lines[0]), display_width(lines[1]));
 }
 
+TEST(TimingTable, RtViolationsColumnWithTheCheckOrWhenAnyTaskHasSome) {
+  EXPECT_EQ(timing_table(sample()).find("rt violations"), std::string::npos);
+  // With --rt-check, zeros are the answer: the column shows.
+  const auto checked = lines_of(timing_table(sample(), true));
+  EXPECT_NE(checked[0].find("rt violations"), std::string::npos);
+  auto tasks = sample();
+  tasks[0].stats.rt_violations = 2000;
+  const auto lines = lines_of(timing_table(tasks));
+  ASSERT_NE(lines[0].find("rt violations"), std::string::npos);
+  EXPECT_NE(lines[1].find("2000"), std::string::npos);
+  EXPECT_EQ(display_width(lines[0]), display_width(lines[1]));
+}
+
+TEST(StatsJson, RtViolationsPerTaskAndWhetherTheyWereCounted) {
+  auto tasks = sample();
+  tasks[0].stats.rt_violations = 7;
+  const auto doc = nlohmann::json::parse(stats_json(tasks, ClockKind::kVirtual, 0, true));
+  EXPECT_EQ(doc.at("rt_check"), true);
+  EXPECT_EQ(doc.at("tasks").at("pid").at("rt_violations"), 7);
+  EXPECT_EQ(doc.at("tasks").at("traj").at("rt_violations"), 0);
+  EXPECT_EQ(nlohmann::json::parse(stats_json(tasks, ClockKind::kVirtual, 0)).at("rt_check"), false);
+}
+
 TEST(StatsJson, HasTheContractKeys) {
   const auto doc = nlohmann::json::parse(stats_json(sample(), ClockKind::kVirtual, 0));
   EXPECT_EQ(doc.at("clock"), "virtual");
