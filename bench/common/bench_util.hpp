@@ -21,6 +21,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "chimera/exec/clock.hpp"
+
 namespace chimera::bench {
 
 /// The command line of every benchmark program.
@@ -118,11 +120,9 @@ nlohmann::json summary(std::vector<T>& v) {
   return j;
 }
 
-inline std::int64_t monotonic_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
+// The framework's own clock reading, so that a benchmark that also includes the subsystem's
+// headers (which declare chimera::monotonic_ns) has one name, not two.
+using chimera::monotonic_ns;
 
 /// Pins the calling thread to one CPU. False if the system refuses.
 inline bool pin_to_cpu(int cpu) {
