@@ -42,8 +42,8 @@ bool needs_measuring(const std::vector<TaskModel>& models) {
 }
 
 // Prints the violations of the configurations to analyse; true when there are none.
-bool legal(const SubsystemSpec& spec, const std::optional<std::string>& config) {
-  const auto violations = verify_subsystem(resolve_subsystem(spec, Registry::global()), config);
+bool legal(const SubsystemSpec& spec, const Resolution& resolution, const std::optional<std::string>& config) {
+  const auto violations = verify_subsystem(resolution, config);
   for (const auto& v : violations) fmt::print(stderr, "{}: {}\n", spec.file, v.message);
   if (violations.empty()) return true;
   fmt::print(stderr, "{}: only legal configurations can be analysed (chimera verify says more)\n", spec.file);
@@ -51,13 +51,15 @@ bool legal(const SubsystemSpec& spec, const std::optional<std::string>& config) 
 }
 
 // nullopt: the configuration could not be analysed (the message is printed on stderr).
-std::optional<analysis::AnalysedConfiguration> analyse_one(const SubsystemSpec& spec, const ConfigurationSpec& config,
-                                                           const WcetProfile* profile,
+std::optional<analysis::AnalysedConfiguration> analyse_one(const SubsystemSpec& spec,
+                                                           const analysis::ReleaseOrder& order,
+                                                           const ConfigurationSpec& config, const WcetProfile* profile,
                                                            const analysis::AnalysisOptions& options) {
-  // The CPUs come from what `chimera run` knows too (the file's wcet: and cpu:), so that the
-  // assignment shown is the one a run makes; profile and measurements only refine the analysis.
+  // The CPUs come from what `chimera run` knows too (the file's wcet: and cpu:, its chains), so
+  // that the assignment shown is the one a run makes; profile and measurements only refine the
+  // analysis.
   const auto cpus = analysis::allowed_cpus(spec, static_cast<int>(::sysconf(_SC_NPROCESSORS_ONLN)));
-  const auto file_cpu = analysis::assign_subsystem_cpus(spec, cpus, options);
+  const auto file_cpu = analysis::assign_subsystem_cpus(spec, order, cpus, options);
 
   std::optional<WcetProfile> measured;
   std::string note;
@@ -75,7 +77,7 @@ std::optional<analysis::AnalysedConfiguration> analyse_one(const SubsystemSpec& 
         "(chimera profile and --wcet-from give better figures)",
         analysis::kMeasuredMargin, kMeasureRuns, format_period(length));
   }
-  const auto models = analysis::task_models(spec, config.tasks, profile, measured ? &*measured : nullptr);
+  const auto models = analysis::task_models(spec, config.tasks, profile, measured ? &*measured : nullptr, &order);
   std::vector<int> cpu_of;
   cpu_of.reserve(models.size());
   for (const auto& m : models) cpu_of.push_back(file_cpu[static_cast<std::size_t>(m.file_index)]);
@@ -122,7 +124,9 @@ int analyze_command(const AnalyzeArgs& args) {
     }
     profile = *std::move(read);
   }
-  if (!legal(*spec, args.config)) return kExitInvalid;
+  const Resolution resolution = resolve_subsystem(*spec, Registry::global());
+  if (!legal(*spec, resolution, args.config)) return kExitInvalid;
+  const analysis::ReleaseOrder order = analysis::compute_release_order(resolution.subsystem);
 
   const analysis::AnalysisOptions options{.overhead_ns = args.overhead_ns};
   // JSON is printed whole at the end, so that stdout holds one complete document or, when a
@@ -131,7 +135,7 @@ int analyze_command(const AnalyzeArgs& args) {
   std::size_t infeasible = 0;
   for (const auto& config : spec->configurations) {
     if (args.config && config.name != *args.config) continue;
-    auto a = analyse_one(*spec, config, profile ? &*profile : nullptr, options);
+    auto a = analyse_one(*spec, order, config, profile ? &*profile : nullptr, options);
     if (!a) return kExitInvalid;
     infeasible += a->result.feasible ? 0 : 1;
     if (!args.json) {

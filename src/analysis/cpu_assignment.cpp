@@ -1,6 +1,7 @@
 #include "chimera/analysis/cpu_assignment.hpp"
 
 #include <algorithm>
+#include <map>
 #include <numeric>
 
 #include "chimera/analysis/response_time.hpp"
@@ -53,17 +54,17 @@ bool bounded_by_deadlines(std::span<const TaskModel> tasks, SchedulerKind schedu
   return true;
 }
 
-// Whether `cpu` stays schedulable with `task` added. Sufficient tests first, since this runs for
-// every task and CPU, on the density sum C / min(D, T): a set is no harder than the same set with
-// every period and deadline cut to min(D, T). Where that keeps the priority order (rm with every
-// D >= T, dm with every D <= T), Liu and Layland's bound on the density suffices; for edf,
+// Whether `cpu` stays schedulable with `added` placed on it. Sufficient tests first, since this
+// runs for every task and CPU, on the density sum C / min(D, T): a set is no harder than the same
+// set with every period and deadline cut to min(D, T). Where that keeps the priority order (rm with
+// every D >= T, dm with every D <= T), Liu and Layland's bound on the density suffices; for edf,
 // density <= 1; for muf the hard tasks' density <= 1, since soft tasks never make it infeasible.
 // For rm and dm, the response-time bound of Bini and Baruah next. Near the limits the exact
 // analysis decides.
-bool fits(const Cpu& cpu, const TaskModel& task, SchedulerKind scheduler, const AnalysisOptions& options) {
+bool fits(const Cpu& cpu, std::span<const TaskModel> added, SchedulerKind scheduler, const AnalysisOptions& options) {
   constexpr double kSafety = 1e-9;  // the sums are in floating point; the exact test settles the rest
   std::vector<TaskModel> with = cpu.known;
-  with.push_back(task);
+  with.insert(with.end(), added.begin(), added.end());
   double density = 0;
   double hard_density = 0;
   bool late = true;   // every D >= T
@@ -94,6 +95,50 @@ bool fits(const Cpu& cpu, const TaskModel& task, SchedulerKind scheduler, const 
   return analyse_cpu(with, scheduler, options).feasible;
 }
 
+// What assignment places together: the unpinned tasks of one same-rate chain (TaskModel::chain),
+// or one task alone. A chain split over CPUs makes each consumer wait for its producer on the
+// other CPU at every release, so a chain goes whole onto one CPU whenever it fits there.
+struct Unit {
+  std::vector<std::size_t> members;  // indices into the tasks, in file order
+  bool known = true;                 // every member's C is known
+  double share = 0;                  // the members' utilisation, where known
+  std::int64_t period_ns = 0;        // the chain's period (0: background)
+  int first = 0;                     // file index of the first member: the last tie-break
+  int pinned_cpu = -1;               // the CPU a pinned task of the chain is on, if any
+};
+
+std::vector<Unit> units_of(std::span<const TaskModel> tasks, const AnalysisOptions& options) {
+  std::map<int, int> pinned_cpu;  // chain -> the CPU of its first pinned task
+  for (const auto& t : tasks)
+    if (t.cpu >= 0 && t.chain >= 0) pinned_cpu.emplace(t.chain, t.cpu);
+  std::vector<Unit> units;
+  std::map<int, std::size_t> unit_of_chain;
+  for (std::size_t i = 0; i < tasks.size(); ++i) {
+    const TaskModel& t = tasks[i];
+    if (t.cpu >= 0) continue;
+    std::size_t u = units.size();
+    if (t.chain >= 0) {
+      const auto [at, added] = unit_of_chain.emplace(t.chain, units.size());
+      u = at->second;
+      if (!added) {
+        units[u].members.push_back(i);
+        units[u].known = units[u].known && demand_of(t, options).has_value();
+        units[u].share += share(t, options);
+        continue;
+      }
+    }
+    Unit unit;
+    unit.members.push_back(i);
+    unit.known = demand_of(t, options).has_value();
+    unit.share = share(t, options);
+    unit.period_ns = t.period_ns;
+    unit.first = t.file_index;
+    if (const auto p = pinned_cpu.find(t.chain); t.chain >= 0 && p != pinned_cpu.end()) unit.pinned_cpu = p->second;
+    units.push_back(std::move(unit));
+  }
+  return units;
+}
+
 }  // namespace
 
 std::vector<int> assign_cpus(std::span<const TaskModel> tasks, std::span<const int> cpus, SchedulerKind scheduler,
@@ -115,59 +160,85 @@ std::vector<int> assign_cpus(std::span<const TaskModel> tasks, std::span<const i
     }
   };
 
-  std::vector<std::size_t> known;
-  std::vector<std::size_t> unknown;
   for (std::size_t i = 0; i < tasks.size(); ++i) {
-    if (tasks[i].cpu >= 0) {
-      cpu_of[i] = tasks[i].cpu;
-      if (auto at = find(tasks[i].cpu); at != state.end()) place(i, *at);
-    } else {
-      (demand_of(tasks[i], options) ? known : unknown).push_back(i);
-    }
+    if (tasks[i].cpu < 0) continue;
+    cpu_of[i] = tasks[i].cpu;
+    if (auto at = find(tasks[i].cpu); at != state.end()) place(i, *at);
   }
   if (state.empty()) return cpu_of;
 
-  std::sort(known.begin(), known.end(), [&](std::size_t a, std::size_t b) {
-    const double ua = share(tasks[a], options);
-    const double ub = share(tasks[b], options);
-    if (ua != ub) return ua > ub;
-    if (tasks[a].period_ns != tasks[b].period_ns) return tasks[a].period_ns < tasks[b].period_ns;
-    return tasks[a].file_index < tasks[b].file_index;
+  std::vector<Unit> known;
+  std::vector<Unit> unknown;
+  for (auto& u : units_of(tasks, options)) (u.known ? known : unknown).push_back(std::move(u));
+
+  // Worst fit decreasing by the unit's utilisation: the least-loaded CPU on which the unit fits
+  // whole, the CPU of its pinned tasks first. A chain that fits nowhere whole is split, task by task.
+  std::stable_sort(known.begin(), known.end(), [](const Unit& a, const Unit& b) {
+    if (a.share != b.share) return a.share > b.share;
+    if (a.period_ns != b.period_ns) return a.period_ns < b.period_ns;
+    return a.first < b.first;
   });
-  for (const std::size_t i : known) {
-    std::vector<Cpu*> by_load;
-    by_load.reserve(state.size());
-    for (auto& c : state) by_load.push_back(&c);
-    std::stable_sort(by_load.begin(), by_load.end(), [](const Cpu* a, const Cpu* b) { return a->load < b->load; });
-    const auto feasible = std::find_if(by_load.begin(), by_load.end(),
-                                       [&](const Cpu* c) { return fits(*c, tasks[i], scheduler, options); });
-    place(i, feasible != by_load.end() ? **feasible : *by_load.front());
+  const auto by_load = [&](int preferred) {
+    std::vector<Cpu*> order;
+    order.reserve(state.size());
+    for (auto& c : state) order.push_back(&c);
+    std::stable_sort(order.begin(), order.end(), [&](const Cpu* a, const Cpu* b) {
+      if ((a->number == preferred) != (b->number == preferred)) return a->number == preferred;
+      return a->load < b->load;
+    });
+    return order;
+  };
+  for (const Unit& unit : known) {
+    std::vector<TaskModel> members;
+    for (const std::size_t i : unit.members) members.push_back(tasks[i]);
+    const auto candidates = by_load(unit.pinned_cpu);
+    const auto whole = std::find_if(candidates.begin(), candidates.end(),
+                                    [&](const Cpu* c) { return fits(*c, members, scheduler, options); });
+    if (whole != candidates.end()) {
+      for (const std::size_t i : unit.members) place(i, **whole);
+      continue;
+    }
+    std::vector<std::size_t> split = unit.members;  // largest first, as the units are
+    std::stable_sort(split.begin(), split.end(),
+                     [&](std::size_t a, std::size_t b) { return share(tasks[a], options) > share(tasks[b], options); });
+    for (const std::size_t i : split) {
+      const auto one = by_load(-1);
+      const auto feasible = std::find_if(one.begin(), one.end(), [&](const Cpu* c) {
+        return fits(*c, std::span<const TaskModel>(&tasks[i], 1), scheduler, options);
+      });
+      place(i, feasible != one.end() ? **feasible : *one.front());
+    }
   }
 
-  // Periodic tasks before background ones, each group by period, then file order.
-  std::sort(unknown.begin(), unknown.end(), [&](std::size_t a, std::size_t b) {
-    const bool ba = is_background(tasks[a]);
-    const bool bb = is_background(tasks[b]);
+  // Units of unknown share: periodic before background, by period, then file order; each whole on
+  // the CPU of its pinned tasks, else the one with the fewest such tasks, then the lowest load,
+  // then the lower number: spread evenly, never all on one CPU.
+  std::stable_sort(unknown.begin(), unknown.end(), [](const Unit& a, const Unit& b) {
+    const bool ba = a.period_ns <= 0;
+    const bool bb = b.period_ns <= 0;
     if (ba != bb) return bb;
-    if (tasks[a].period_ns != tasks[b].period_ns) return tasks[a].period_ns < tasks[b].period_ns;
-    return tasks[a].file_index < tasks[b].file_index;
+    if (a.period_ns != b.period_ns) return a.period_ns < b.period_ns;
+    return a.first < b.first;
   });
-  for (const std::size_t i : unknown) {
-    const auto least = std::min_element(state.begin(), state.end(), [](const Cpu& a, const Cpu& b) {
-      if (a.unknown != b.unknown) return a.unknown < b.unknown;
-      return a.load < b.load;  // min_element keeps the first (lower number) on a tie
-    });
-    place(i, *least);
+  for (const Unit& unit : unknown) {
+    auto target = find(unit.pinned_cpu);
+    if (target == state.end())
+      target = std::min_element(state.begin(), state.end(), [](const Cpu& a, const Cpu& b) {
+        if (a.unknown != b.unknown) return a.unknown < b.unknown;
+        return a.load < b.load;  // min_element keeps the first (lower number) on a tie
+      });
+    for (const std::size_t i : unit.members) place(i, *target);
   }
   return cpu_of;
 }
 
-std::vector<int> assign_subsystem_cpus(const SubsystemSpec& spec, std::span<const int> cpus,
+std::vector<int> assign_subsystem_cpus(const SubsystemSpec& spec, const ReleaseOrder& order, std::span<const int> cpus,
                                        const AnalysisOptions& options) {
   std::vector<std::string> names;
   names.reserve(spec.tasks.size());
   for (const auto& t : spec.tasks) names.push_back(t.name);
-  return assign_cpus(task_models(spec, names), cpus, spec.scheduler, options);  // file order, one per task
+  // File order, one per task; with the chains of the whole file, whichever configuration they are in.
+  return assign_cpus(task_models(spec, names, nullptr, nullptr, &order), cpus, spec.scheduler, options);
 }
 
 std::vector<int> allowed_cpus(const SubsystemSpec& spec, int online_cpus) {

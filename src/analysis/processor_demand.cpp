@@ -16,13 +16,21 @@ constexpr std::int64_t kMax = std::numeric_limits<std::int64_t>::max();
 constexpr std::int64_t kHorizonNs = kMax / 4;
 constexpr long kMaxSteps = 20'000'000;
 
-// The synchronous busy period: the least L > 0 with L = sum ceil(L / T) C. Finite when U <= 1.
+// The deadline relative to the latest moment the job can become ready: a job whose release can be
+// J late must finish within D - J of becoming ready. With it, h(t) is the demand of jobs with
+// jitter (Spuri 1996), and every test below holds as for a task without jitter. 0 when J >= D:
+// such a job cannot be guaranteed, and h(0) > 0 says so.
+std::int64_t ready_deadline(const Demand& t) { return std::max<std::int64_t>(t.d_ns - t.j_ns, 0); }
+
+// The longest busy period: the least L > 0 with L = sum ceil((L + J) / T) C (a task with jitter
+// can bring a job J early into the window). Finite when U <= 1. A missed deadline comes first
+// within one, so no interval longer than L needs checking.
 std::optional<std::int64_t> busy_period(std::span<const Demand> tasks) {
   Wide w = 0;
   for (const auto& t : tasks) w += t.c_ns;
   for (long step = 0; step < kMaxSteps && w <= kHorizonNs; ++step) {
     Wide next = 0;
-    for (const auto& t : tasks) next += (w + t.t_ns - 1) / t.t_ns * t.c_ns;
+    for (const auto& t : tasks) next += (w + t.j_ns + t.t_ns - 1) / t.t_ns * t.c_ns;
     if (next == w) return static_cast<std::int64_t>(w);
     w = next;
   }
@@ -38,9 +46,9 @@ std::optional<std::int64_t> george_bound(std::span<const Demand> tasks, double u
   long double sum = 0;
   std::int64_t d_max = 0;
   for (const auto& t : tasks) {
-    sum +=
-        static_cast<long double>(t.t_ns - t.d_ns) * static_cast<long double>(t.c_ns) / static_cast<long double>(t.t_ns);
-    d_max = std::max(d_max, t.d_ns);
+    sum += static_cast<long double>(t.t_ns - ready_deadline(t)) * static_cast<long double>(t.c_ns) /
+           static_cast<long double>(t.t_ns);
+    d_max = std::max(d_max, ready_deadline(t));
   }
   const long double bound = std::ceil(sum / slack * (1.0L + 1e-6L)) + 1.0L;
   if (bound > static_cast<long double>(kHorizonNs)) return std::nullopt;
@@ -51,8 +59,9 @@ std::optional<std::int64_t> george_bound(std::span<const Demand> tasks, double u
 std::optional<std::int64_t> deadline_before(std::span<const Demand> tasks, std::int64_t t) {
   std::optional<std::int64_t> latest;
   for (const auto& x : tasks) {
-    if (t <= x.d_ns) continue;
-    const std::int64_t d = (t - x.d_ns - 1) / x.t_ns * x.t_ns + x.d_ns;
+    const std::int64_t dx = ready_deadline(x);
+    if (t <= dx) continue;
+    const std::int64_t d = (t - dx - 1) / x.t_ns * x.t_ns + dx;
     if (!latest || d > *latest) latest = d;
   }
   return latest;
@@ -60,10 +69,16 @@ std::optional<std::int64_t> deadline_before(std::span<const Demand> tasks, std::
 
 }  // namespace
 
+std::optional<std::int64_t> longest_busy_period(std::span<const Demand> tasks) {
+  if (tasks.empty()) return 0;
+  if (!utilisation_at_most_one(tasks)) return std::nullopt;
+  return busy_period(tasks);
+}
+
 std::int64_t processor_demand(std::span<const Demand> tasks, std::int64_t t) {
   Wide h = 0;
   for (const auto& x : tasks)
-    if (t >= x.d_ns) h += static_cast<Wide>((t - x.d_ns) / x.t_ns + 1) * x.c_ns;
+    if (t >= ready_deadline(x)) h += static_cast<Wide>((t - ready_deadline(x)) / x.t_ns + 1) * x.c_ns;
   return h > kMax ? kMax : static_cast<std::int64_t>(h);
 }
 
@@ -74,7 +89,8 @@ EdfTest edf_test(std::span<const Demand> tasks) {
     r.outcome = EdfOutcome::kOverloaded;
     return r;
   }
-  r.utilisation_decides = std::all_of(tasks.begin(), tasks.end(), [](const Demand& t) { return t.d_ns >= t.t_ns; });
+  r.utilisation_decides =
+      std::all_of(tasks.begin(), tasks.end(), [](const Demand& t) { return ready_deadline(t) >= t.t_ns; });
   if (r.utilisation_decides || tasks.empty()) {
     r.outcome = EdfOutcome::kFeasible;
     return r;
@@ -88,7 +104,7 @@ EdfTest edf_test(std::span<const Demand> tasks) {
 
   // QPA: from the latest deadline before L downwards; h(t) < t lets it jump to h(t) at once.
   std::int64_t d_min = kMax;
-  for (const auto& t : tasks) d_min = std::min(d_min, t.d_ns);
+  for (const auto& t : tasks) d_min = std::min(d_min, ready_deadline(t));
   auto t = deadline_before(tasks, r.bound_ns);
   while (t) {
     if (++r.points > kMaxSteps) return r;  // kGaveUp

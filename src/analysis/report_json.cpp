@@ -104,6 +104,8 @@ Json task_json(const TaskModel& t, const TaskResult& r, int cpu, bool muf) {
   out["analysed_c_ns"] = r.demand ? Json(r.demand->c_ns) : Json(nullptr);
   out["response_ns"] = ns_or_null(r.response_ns);
   out["response_kind"] = response_kind(r);
+  // The wait for same-rate producers on other CPUs that response_ns includes (0: none).
+  out["release_jitter_ns"] = r.release_jitter_ns;
   out["verdict"] = verdict_name(r.verdict);
   if (muf) out["critical"] = r.critical;
   out["reason"] = r.reason;

@@ -20,10 +20,11 @@ constexpr int kMaxJobs = 1'000'000;
 
 Wide ceil_div(Wide a, Wide b) { return (a + b - 1) / b; }
 
-// Interference in a window of length w: sum over j of ceil(w / T_j) C_j.
+// Interference in a window of length w: sum over j of ceil((w + J_j) / T_j) C_j (a task with
+// release jitter J_j can bring one more job into the window; Audsley et al. 1993).
 Wide interference_in(std::span<const Demand> tasks, Wide w) {
   Wide sum = 0;
-  for (const auto& t : tasks) sum += ceil_div(w, t.t_ns) * t.c_ns;
+  for (const auto& t : tasks) sum += ceil_div(w + t.j_ns, t.t_ns) * t.c_ns;
   return sum;
 }
 
@@ -44,8 +45,10 @@ ResponseTime response_time(const Demand& task, std::span<const Demand> interfere
   }
 
   // Job q (from 0) of the level-i busy period that starts at the critical instant completes at
-  // the least w with w = (q+1) C + interference(w); its response time is w - q T. The busy period
-  // ends with the first job that completes before the task's next release.
+  // the least w with w = (q+1) C + interference(w); its response time, from its release, is
+  // w - q T + J (its own jitter: it became ready J after its release). The busy period ends with
+  // the first job that completes before the task's next job can become ready (Tindell, Burns and
+  // Wellings 1994).
   Wide w = task.c_ns + std::accumulate(interference.begin(), interference.end(), Wide{0},
                                        [](Wide s, const Demand& d) { return s + d.c_ns; });
   Wide worst = 0;
@@ -60,15 +63,15 @@ ResponseTime response_time(const Demand& task, std::span<const Demand> interfere
       if (++steps > kMaxSteps || w > kHorizonNs) {
         r.jobs = q + 1;
         r.outcome = missed ? RtaOutcome::kMisses : RtaOutcome::kGaveUp;
-        r.response_ns = static_cast<std::int64_t>(std::max(worst, w - static_cast<Wide>(q) * task.t_ns));
+        r.response_ns = static_cast<std::int64_t>(std::max(worst, w - static_cast<Wide>(q) * task.t_ns + task.j_ns));
         return r;
       }
     }
-    const Wide response = w - static_cast<Wide>(q) * task.t_ns;
+    const Wide response = w - static_cast<Wide>(q) * task.t_ns + task.j_ns;
     worst = std::max(worst, response);
     missed = missed || response > task.d_ns;
     r.jobs = q + 1;
-    if (w <= static_cast<Wide>(q + 1) * task.t_ns) {
+    if (w + task.j_ns <= static_cast<Wide>(q + 1) * task.t_ns) {
       r.outcome = missed ? RtaOutcome::kMisses : RtaOutcome::kMeets;
       r.response_ns = static_cast<std::int64_t>(worst);
       r.exact = true;

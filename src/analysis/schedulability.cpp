@@ -1,7 +1,9 @@
 #include "chimera/analysis/schedulability.hpp"
 
 #include <algorithm>
+#include <map>
 #include <set>
+#include <tuple>
 
 #include <fmt/format.h>
 
@@ -138,6 +140,7 @@ void analyse_edf(std::span<const TaskModel> tasks, const std::vector<std::option
       unknown = tasks[i].name;
   }
   cpu.edf = edf_test(known);
+  if (cpu.edf.outcome == EdfOutcome::kFeasible) cpu.busy_period_ns = longest_busy_period(known).value_or(0);
   for (const std::size_t i : order) {
     TaskResult r;
     r.index = i;
@@ -158,9 +161,17 @@ void analyse_edf(std::span<const TaskModel> tasks, const std::vector<std::option
   }
 }
 
+// MUF's critical set is chosen from C, T and D alone, as the runtime chooses it (it knows no
+// jitter); waits for producers on other CPUs are then checked against the set that holds.
+CriticalSet critical_set_without_jitter(std::span<const TaskModel> tasks, const AnalysisOptions& options) {
+  std::vector<TaskModel> plain(tasks.begin(), tasks.end());
+  for (auto& t : plain) t.release_jitter_ns = 0;
+  return muf_critical_set(plain, options);
+}
+
 void analyse_muf(std::span<const TaskModel> tasks, const std::vector<std::optional<Demand>>& demands,
                  const AnalysisOptions& options, CpuResult& cpu) {
-  const CriticalSet set = muf_critical_set(tasks, options);
+  const CriticalSet set = critical_set_without_jitter(tasks, options);
   const auto unfit = [&](std::size_t i) {
     return std::find(set.unfit_hard.begin(), set.unfit_hard.end(), i) != set.unfit_hard.end();
   };
@@ -169,6 +180,7 @@ void analyse_muf(std::span<const TaskModel> tasks, const std::vector<std::option
   for (const std::size_t i : order)
     if (set.critical[i] && !unfit(i)) fitting.push_back(*demands[i]);
   cpu.edf = edf_test(fitting);
+  if (cpu.edf.outcome == EdfOutcome::kFeasible) cpu.busy_period_ns = longest_busy_period(fitting).value_or(0);
 
   std::vector<TaskResult> critical;
   std::vector<TaskResult> others;
@@ -177,7 +189,9 @@ void analyse_muf(std::span<const TaskModel> tasks, const std::vector<std::option
     r.index = i;
     r.demand = demands[i];
     r.critical = set.critical[i];
-    if (r.critical && !unfit(i)) {
+    if (r.critical && !unfit(i) && cpu.edf.outcome != EdfOutcome::kFeasible) {
+      r.reason = "critical, but with the waits for producers on other CPUs, " + edf_failure_reason(cpu.edf);
+    } else if (r.critical && !unfit(i)) {
       r.verdict = Verdict::kMeets;
       r.response_ns = r.demand->d_ns;
       r.response_is_bound = true;
@@ -199,7 +213,7 @@ void analyse_muf(std::span<const TaskModel> tasks, const std::vector<std::option
   }
   for (auto& r : critical) cpu.tasks.push_back(std::move(r));
   for (auto& r : others) cpu.tasks.push_back(std::move(r));
-  cpu.feasible = set.feasible;
+  cpu.feasible = set.feasible && cpu.edf.outcome == EdfOutcome::kFeasible;
 }
 
 }  // namespace
@@ -243,9 +257,11 @@ CpuResult analyse_cpu(std::span<const TaskModel> tasks, SchedulerKind scheduler,
   return cpu;
 }
 
-ConfigurationResult analyse_configuration(std::span<const TaskModel> tasks, std::span<const int> cpu_of,
-                                          std::span<const int> cpus, SchedulerKind scheduler,
-                                          const AnalysisOptions& options) {
+namespace {
+
+// Every CPU of the configuration analysed once, with the tasks' jitter as given.
+ConfigurationResult analyse_cpus(std::span<const TaskModel> tasks, std::span<const int> cpu_of,
+                                 std::span<const int> cpus, SchedulerKind scheduler, const AnalysisOptions& options) {
   ConfigurationResult result;
   result.cpu_of.assign(cpu_of.begin(), cpu_of.end());
   std::set<int> all(cpus.begin(), cpus.end());
@@ -263,6 +279,161 @@ ConfigurationResult analyse_configuration(std::span<const TaskModel> tasks, std:
     for (auto& t : r.tasks) t.index = global[t.index];
     result.feasible = result.feasible && r.feasible;
     result.cpus.push_back(std::move(r));
+  }
+  return result;
+}
+
+// How long after its release a job of the task can end at worst, if bounded: the exact response
+// time under rm and dm; under edf and muf (a bound D only), its jitter plus the CPU's longest busy
+// period when that is shorter, since the CPU is busy from when the job is ready until it ends.
+std::optional<std::int64_t> completion_bound(const ConfigurationResult& result, std::size_t task,
+                                             std::int64_t jitter_ns) {
+  for (const auto& cpu : result.cpus)
+    for (const auto& r : cpu.tasks) {
+      if (r.index != task) continue;
+      if (r.verdict != Verdict::kMeets || r.response_ns <= 0) return std::nullopt;
+      if (r.response_is_bound && cpu.busy_period_ns > 0) return std::min(r.response_ns, jitter_ns + cpu.busy_period_ns);
+      return r.response_ns;
+    }
+  return std::nullopt;
+}
+
+// A task's waits for same-rate producers on other CPUs (the same-rate rule): the longest of their
+// response times is how late after its release it may start, its release jitter. A producer
+// without a bound (it can miss, or is promised nothing) leaves the task without one: the runtime
+// would wait up to half its deadline for it, then run on the previous cycle's value.
+struct CrossCpuWait {
+  std::int64_t jitter_ns = 0;
+  std::string longest;    // the producer it waits longest for
+  std::string unbounded;  // a producer without a bound, if any
+  std::string behind;     // the task of its thread that waits, when it is not the task itself
+};
+
+// Under rm and dm the periodic tasks of one CPU, one priority and one period share a thread that
+// runs them one after the other in data-flow order (docs/scheduling.md), so a task that waits for
+// a producer on another CPU holds up the others of its thread too. Each gets the worst wait of its
+// thread: for those before the waiter in the order that is more than they wait, on the safe side.
+void share_waits_within_threads(std::span<const TaskModel> tasks, std::span<const int> cpu_of, SchedulerKind scheduler,
+                                std::vector<CrossCpuWait>& waits) {
+  if (scheduler != SchedulerKind::kRm && scheduler != SchedulerKind::kDm) return;
+  const auto worse = [&](std::size_t a, std::size_t b) {  // whether a's wait is worse than b's
+    if (waits[a].unbounded.empty() != waits[b].unbounded.empty()) return !waits[a].unbounded.empty();
+    return waits[a].jitter_ns > waits[b].jitter_ns;
+  };
+  std::map<std::tuple<int, std::int64_t, std::int64_t>, std::size_t> worst;  // thread -> its worst waiter
+  const auto thread_of = [&](std::size_t i) {
+    const std::int64_t level = scheduler == SchedulerKind::kRm ? tasks[i].period_ns : relative_deadline(tasks[i]);
+    return std::tuple{cpu_of[i], level, tasks[i].period_ns};
+  };
+  for (std::size_t i = 0; i < tasks.size(); ++i) {
+    if (is_background(tasks[i]) || tasks[i].server) continue;
+    const auto [at, added] = worst.emplace(thread_of(i), i);
+    if (!added && worse(i, at->second)) at->second = i;
+  }
+  for (std::size_t i = 0; i < tasks.size(); ++i) {
+    if (is_background(tasks[i]) || tasks[i].server) continue;
+    const std::size_t w = worst.at(thread_of(i));
+    if (w == i || !worse(w, i)) continue;
+    waits[i] = waits[w];
+    waits[i].behind = tasks[w].name;
+  }
+}
+
+CrossCpuWait cross_cpu_wait(std::span<const TaskModel> tasks, std::span<const int> cpu_of,
+                            const std::vector<int>& position, std::size_t i, const ConfigurationResult& result) {
+  CrossCpuWait wait;
+  for (const int producer : tasks[i].same_rate_producers) {
+    if (producer < 0 || static_cast<std::size_t>(producer) >= position.size()) continue;
+    const int p = position[static_cast<std::size_t>(producer)];
+    if (p < 0 || cpu_of[static_cast<std::size_t>(p)] == cpu_of[i]) continue;  // not in it, or one CPU
+    const auto end =
+        completion_bound(result, static_cast<std::size_t>(p), tasks[static_cast<std::size_t>(p)].release_jitter_ns);
+    if (!end) {
+      if (wait.unbounded.empty()) wait.unbounded = tasks[static_cast<std::size_t>(p)].name;
+      continue;
+    }
+    if (*end > wait.jitter_ns) {
+      wait.jitter_ns = *end;
+      wait.longest = tasks[static_cast<std::size_t>(p)].name;
+    }
+  }
+  return wait;
+}
+
+}  // namespace
+
+ConfigurationResult analyse_configuration(std::span<const TaskModel> tasks, std::span<const int> cpu_of,
+                                          std::span<const int> cpus, SchedulerKind scheduler,
+                                          const AnalysisOptions& options) {
+  // Position in `tasks` of each file index, to find a task's producers among them.
+  int last = -1;
+  for (const auto& t : tasks) last = std::max(last, t.file_index);
+  std::vector<int> position(static_cast<std::size_t>(last + 1), -1);
+  for (std::size_t i = 0; i < tasks.size(); ++i)
+    position[static_cast<std::size_t>(tasks[i].file_index)] = static_cast<int>(i);
+
+  // Holistic analysis (Tindell and Clark 1994): a consumer's jitter is its producers' response
+  // time, which the consumer's own jitter can lengthen on their CPU in turn. Jitter only grows from
+  // round to round and a response past the deadline ends it, so this settles; a bound on the rounds
+  // keeps a pathological set from taking long.
+  std::vector<TaskModel> jittered(tasks.begin(), tasks.end());
+  for (auto& t : jittered) t.release_jitter_ns = 0;
+  ConfigurationResult result = analyse_cpus(jittered, cpu_of, cpus, scheduler, options);
+  std::vector<CrossCpuWait> waits(tasks.size());
+  const std::size_t max_rounds = 2 * tasks.size() + 4;
+  bool settled = false;
+  for (std::size_t round = 0; round < max_rounds && !settled; ++round) {
+    settled = true;
+    for (std::size_t i = 0; i < tasks.size(); ++i) waits[i] = cross_cpu_wait(jittered, cpu_of, position, i, result);
+    share_waits_within_threads(jittered, cpu_of, scheduler, waits);
+    for (std::size_t i = 0; i < tasks.size(); ++i) {
+      if (waits[i].jitter_ns > jittered[i].release_jitter_ns) {
+        jittered[i].release_jitter_ns = waits[i].jitter_ns;
+        settled = false;
+      }
+    }
+    if (!settled) result = analyse_cpus(jittered, cpu_of, cpus, scheduler, options);
+  }
+
+  // What the waits do to the verdicts: say how long a task that meets may wait, and refuse a bound
+  // to a task that waits for an unbounded producer.
+  result.feasible = true;
+  for (auto& cpu : result.cpus) {
+    for (auto& r : cpu.tasks) {
+      const CrossCpuWait& wait = waits[r.index];
+      r.release_jitter_ns = jittered[r.index].release_jitter_ns;
+      // A run waits at most half the deadline (release_policy::producer_wait_until), then goes on
+      // with the producer's previous value: the time is kept, the same-rate order is not. Analysis
+      // counts the whole wait, on the safe side, and says where the two part.
+      if (r.verdict == Verdict::kCanMiss && r.release_jitter_ns > 0 &&
+          2 * r.release_jitter_ns > relative_deadline(tasks[r.index]) && !wait.longest.empty())
+        r.reason += fmt::format(
+            "; it waits up to {} for {} on another CPU, past half its deadline, where a run stops waiting and "
+            "reads {}'s previous value (an order timeout): keep the chain on one CPU",
+            exact_duration_text(r.release_jitter_ns), wait.longest, wait.longest);
+      if (r.verdict != Verdict::kMeets) continue;
+      if (!wait.unbounded.empty() || (!settled && r.release_jitter_ns > 0)) {
+        r.verdict = Verdict::kCanMiss;
+        r.response_ns = 0;
+        r.response_is_bound = false;
+        r.reason =
+            !wait.unbounded.empty()
+                ? fmt::format("cannot be bounded: {} for {} on another CPU, which has no bound",
+                              wait.behind.empty() ? "it waits" : wait.behind + ", on its thread, waits", wait.unbounded)
+                : std::string("cannot be bounded: the waits for producers on other CPUs did not settle");
+      } else if (r.release_jitter_ns > 0 && wait.behind.empty()) {
+        r.reason = fmt::format("after waiting up to {} for {} on another CPU", exact_duration_text(r.release_jitter_ns),
+                               wait.longest);
+      } else if (r.release_jitter_ns > 0) {
+        r.reason = fmt::format("after waiting up to {} behind {}, on its thread, which waits for {} on another CPU",
+                               exact_duration_text(r.release_jitter_ns), wait.behind, wait.longest);
+      }
+    }
+    // A task that can miss makes its CPU infeasible; under muf only critical tasks can (the others
+    // are promised nothing), so the rule is the same for every scheduler.
+    cpu.feasible = cpu.feasible && std::none_of(cpu.tasks.begin(), cpu.tasks.end(),
+                                                [](const TaskResult& r) { return r.verdict == Verdict::kCanMiss; });
+    result.feasible = result.feasible && cpu.feasible;
   }
   return result;
 }

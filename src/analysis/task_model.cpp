@@ -16,7 +16,8 @@ std::string_view wcet_source_name(WcetSource source) {
 std::optional<Demand> demand_of(const TaskModel& task, const AnalysisOptions& options) {
   if (is_background(task) || !wcet_known(task)) return std::nullopt;
   const std::int64_t overrun = task.server ? task.job_wcet_ns : 0;
-  return Demand{task.wcet_ns + overrun + options.overhead_ns, task.period_ns, relative_deadline(task)};
+  return Demand{task.wcet_ns + overrun + options.overhead_ns, task.period_ns, relative_deadline(task),
+                task.release_jitter_ns};
 }
 
 }  // namespace chimera::analysis

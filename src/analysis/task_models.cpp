@@ -1,6 +1,7 @@
 #include "chimera/analysis/task_models.hpp"
 
 #include <algorithm>
+#include <string_view>
 
 namespace chimera::analysis {
 namespace {
@@ -20,11 +21,15 @@ std::pair<std::int64_t, WcetSource> execution_time(const TaskSpec& t, const Wcet
 }  // namespace
 
 std::vector<TaskModel> task_models(const SubsystemSpec& spec, std::span<const std::string> task_names,
-                                   const WcetProfile* profile, const WcetProfile* measured) {
+                                   const WcetProfile* profile, const WcetProfile* measured, const ReleaseOrder* order) {
+  // Which tasks of the file are named: a set, so that ten thousand names cost no more than a sort.
+  std::vector<std::string_view> named(task_names.begin(), task_names.end());
+  std::sort(named.begin(), named.end());
+  const auto is_named = [&](const std::string& name) { return std::binary_search(named.begin(), named.end(), name); };
   std::vector<TaskModel> models;
   for (std::size_t i = 0; i < spec.tasks.size(); ++i) {
     const TaskSpec& t = spec.tasks[i];
-    if (std::find(task_names.begin(), task_names.end(), t.name) == task_names.end()) continue;
+    if (!is_named(t.name)) continue;
     TaskModel m;
     m.name = t.name;
     const auto [c, source] = execution_time(t, profile, measured);
@@ -43,6 +48,11 @@ std::vector<TaskModel> task_models(const SubsystemSpec& spec, std::span<const st
       m.wcet_ns = t.server->budget_ns;
       m.job_wcet_ns = c;
       m.period_ns = t.server->period_ns;
+    }
+    if (order != nullptr && i < order->chain.size()) {
+      m.chain = order->chain[i];
+      for (const int p : order->predecessors[i])
+        if (is_named(spec.tasks[static_cast<std::size_t>(p)].name)) m.same_rate_producers.push_back(p);
     }
     // late: changes how a run treats the task, not what analysis assumes (a skipped release
     // only lightens the load); virtual_exec counts only where nothing better is known.

@@ -109,7 +109,7 @@ RealExecutive::RealExecutive(ExecutiveSetup setup)
       table_(setup.table),
       events_(setup.events),
       tasks_(std::move(setup.tasks)),
-      order_(compute_release_order(subsystem_)),
+      order_(analysis::compute_release_order(subsystem_)),
       plan_(make_schedule_plan(subsystem_, order_, subsystem_cpus(*subsystem_.spec), setup.configuration)),
       cpus_(plan_.cpu),
       epoch_ns_(monotonic_ns()),
@@ -151,7 +151,7 @@ void RealExecutive::make_workers(const SchedulePlan& plan) {
 }
 
 void RealExecutive::link_workers() {
-  const ReleaseOrder& order = order_;
+  const analysis::ReleaseOrder& order = order_;
   // Whether aperiodic task `j` reads one of task `i`'s outputs: then `i` may trigger it.
   const auto reads_from = [&](const Worker& j, const Worker& i) {
     return std::ranges::any_of(j.task->resolved().bindings, [&](const PortBinding& b) {
@@ -184,7 +184,7 @@ void RealExecutive::make_dispatchers(const SchedulePlan& plan) {
 }
 
 void RealExecutive::form_threads() {
-  const ReleaseOrder& order = order_;
+  const analysis::ReleaseOrder& order = order_;
   // Under rm and dm, periodic tasks of one CPU and one period share a priority, and SCHED_FIFO
   // would run their threads one after the other: one thread runs them, in data-flow order.
   // Everything else (aperiodic tasks, edf and muf's per-job priorities) has a thread of its own.

@@ -16,8 +16,8 @@
 #include <thread>
 #include <vector>
 
+#include "chimera/analysis/release_order.hpp"
 #include "executive.hpp"
-#include "release_order.hpp"
 #include "schedule_plan.hpp"
 
 namespace chimera {
@@ -85,7 +85,7 @@ class RealExecutive final : public Executive {
   GlobalTable* table_;
   EventLog* events_;
   std::vector<Task*> tasks_;
-  ReleaseOrder order_;
+  analysis::ReleaseOrder order_;
   SchedulePlan plan_;
   const std::vector<int> cpus_;  // plan_.cpu as it was made: a switch never moves a task, so any thread may read it
   std::vector<std::unique_ptr<PriorityDispatcher>> dispatchers_;  // outlive the workers that poke them

@@ -259,6 +259,10 @@ void Worker::wait_for_predecessors(std::int64_t release, std::int64_t release_ab
   const std::int64_t give_up =
       release_policy::producer_wait_until(release_abs, monotonic_ns(), task->spec().deadline_ns);
   for (Worker* p : predecessors) {
+    // A producer on this thread has had its turn in this pass (it comes first in data-flow
+    // order); if it has not run the release, it is behind and can only catch up once we return:
+    // waiting for it would be waiting for ourselves, until the bound, at every release.
+    if (p->thread == thread) continue;
     for (;;) {
       // acquire: its cycle's outputs are published
       const bool completed = reached(p->precedence.completed.load(std::memory_order_acquire), release);

@@ -52,7 +52,7 @@ constexpr LateReleases late_releases(LatePolicy late, std::int64_t next_release,
   return {static_cast<std::uint64_t>(n), next_release + n * period};
 }
 
-/// The same-rate rule (release_order.hpp): a consumer's job of release `release` waits for a
+/// The same-rate rule (analysis/release_order.hpp): a consumer's job of release `release` waits for a
 /// same-period producer that is ON (or joining at or before that release), has not completed
 /// that release, and will run it: its next release to run is at or before it. A producer that
 /// turned on later, or skipped that release, is not waited for. Releases in one unit (index or ns).

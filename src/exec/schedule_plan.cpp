@@ -16,14 +16,14 @@ std::vector<int> subsystem_cpus(const SubsystemSpec& spec) {
   return analysis::allowed_cpus(spec, static_cast<int>(std::max(1L, n)));
 }
 
-SchedulePlan make_schedule_plan(const ResolvedSubsystem& subsystem, const ReleaseOrder& order,
+SchedulePlan make_schedule_plan(const ResolvedSubsystem& subsystem, const analysis::ReleaseOrder& order,
                                 const std::vector<int>& cpus, const std::vector<std::string>& configuration) {
   const SubsystemSpec& spec = *subsystem.spec;
   SchedulePlan plan;
   plan.policy = spec.scheduler;
   // The same assignment `chimera analyze` shows: over every task of the file, so that a switch
   // never moves a task to another CPU.
-  plan.cpu = analysis::assign_subsystem_cpus(spec, cpus);
+  plan.cpu = analysis::assign_subsystem_cpus(spec, order, cpus);
   for (std::size_t i = 0; i < spec.tasks.size(); ++i) {
     const TaskSpec& t = spec.tasks[i];
     if (plan.cpu[i] < 0) plan.cpu[i] = cpus.empty() ? 0 : cpus.front();
@@ -40,7 +40,7 @@ SchedulePlan make_schedule_plan(const ResolvedSubsystem& subsystem, const Releas
   if (plan.policy != SchedulerKind::kMuf) return plan;
 
   // MUF's critical set, per CPU, among the tasks of the configuration (analysis/muf.hpp).
-  const auto models = analysis::task_models(spec, configuration);
+  const auto models = analysis::task_models(spec, configuration, nullptr, nullptr, &order);
   for (const int cpu : cpus) {
     std::vector<analysis::TaskModel> on_cpu;
     for (const auto& m : models)

@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "chimera/analysis/release_order.hpp"
 #include "chimera/config/verify.hpp"
-#include "release_order.hpp"
 #include "urgency.hpp"
 
 namespace chimera {
@@ -21,7 +21,7 @@ struct SchedulePlan {
 /// Plans every task of the file on `cpus` (the CPUs the subsystem may use) as `chimera analyze`
 /// does (analysis/cpu_assignment.hpp), with MUF's critical set computed for the tasks of
 /// `configuration` (the others are planned as if alone). Not real-time safe.
-SchedulePlan make_schedule_plan(const ResolvedSubsystem& subsystem, const ReleaseOrder& order,
+SchedulePlan make_schedule_plan(const ResolvedSubsystem& subsystem, const analysis::ReleaseOrder& order,
                                 const std::vector<int>& cpus, const std::vector<std::string>& configuration);
 
 /// The CPUs a subsystem may use: the file's `cpus`, or every online CPU.

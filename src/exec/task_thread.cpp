@@ -51,9 +51,20 @@ void TaskThread::run_periodic_members() {
       detail::futex_wait(bell, rung, earliest == Worker::kNever ? -1 : earliest);
       continue;  // mail, a spurious wake, or a release: the loop tells which
     }
-    // The members' releases that have come, in data-flow order (the members' order).
-    for (Worker* m : members)
-      if (m->prepare() <= monotonic_ns()) m->act();
+    // The members' releases that have come, in data-flow order (the members' order), each member
+    // caught up before the next: after a stall a producer runs its late releases (late: run) or
+    // skips them (late: skip) before its consumers run theirs, so that every consumer finds its
+    // producer's value of the same release. A member that does not move on (off, held, left) ends
+    // its turn, and so does one that has run kCatchUpPerPass releases: a task whose cycles outlast
+    // its period never catches up, and the mail (signals, switches) must still be read.
+    constexpr int kCatchUpPerPass = 256;
+    for (Worker* m : members) {
+      std::int64_t k = -1;
+      for (int n = 0; n < kCatchUpPerPass && m->schedule.k != k && m->prepare() <= monotonic_ns(); ++n) {
+        k = m->schedule.k;
+        m->act();
+      }
+    }
   }
 }
 

@@ -18,7 +18,7 @@ VirtualExecutive::VirtualExecutive(ExecutiveSetup setup)
     : subsystem_(*setup.subsystem),
       table_(*setup.table),
       tasks_(std::move(setup.tasks)),
-      order_(compute_release_order(subsystem_)),
+      order_(analysis::compute_release_order(subsystem_)),
       plan_(make_schedule_plan(subsystem_, order_, subsystem_cpus(*subsystem_.spec), setup.configuration)),
       cpus_(plan_.cpu),
       slots_(tasks_.size()) {

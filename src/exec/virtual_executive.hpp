@@ -14,8 +14,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "chimera/analysis/release_order.hpp"
 #include "executive.hpp"
-#include "release_order.hpp"
 #include "schedule_plan.hpp"
 #include "sporadic_server.hpp"
 
@@ -93,7 +93,7 @@ class VirtualExecutive final : public Executive {
   const ResolvedSubsystem& subsystem_;
   const GlobalTable& table_;
   std::vector<Task*> tasks_;
-  ReleaseOrder order_;
+  analysis::ReleaseOrder order_;
   SchedulePlan plan_;
   const std::vector<int> cpus_;  // plan_.cpu as it was made: a switch never moves a task, so any thread may read it
   ServiceHooks hooks_;

@@ -4,6 +4,7 @@
 // Howell 1990), checked with Quick Processor-demand Analysis (QPA, Zhang and Burns 2009).
 
 #include <cstdint>
+#include <optional>
 #include <span>
 
 #include "chimera/analysis/task_model.hpp"
@@ -33,8 +34,15 @@ struct EdfTest {
 
 /// h(t) = sum over tasks with D <= t of (floor((t - D) / T) + 1) C: the execution of every job
 /// released at or after 0 and due by t, with all tasks released together at 0. Saturates at
-/// INT64_MAX.
+/// INT64_MAX. A task with release jitter J counts with D - J instead of D (Spuri 1996): its job
+/// may become ready J after its release and must still end by release + D.
 [[nodiscard]] std::int64_t processor_demand(std::span<const Demand> tasks, std::int64_t t);
+
+/// The longest busy period of the tasks on one CPU: the least L > 0 with L = sum ceil((L + J) / T) C.
+/// Under a work-conserving scheduler (edf, and muf's critical tasks among themselves) the CPU is
+/// busy from a job's release until it ends, so no job takes longer than L: a response-time bound
+/// where EDF gives no exact one. nullopt when U > 1 or L cannot be found.
+[[nodiscard]] std::optional<std::int64_t> longest_busy_period(std::span<const Demand> tasks);
 
 /// The EDF test for tasks with known C (see demand_of()).
 [[nodiscard]] EdfTest edf_test(std::span<const Demand> tasks);

@@ -31,8 +31,10 @@ struct ResponseTime {
   double level_utilisation = 0;
 };
 
-/// The worst-case response time of `task` when every task in `interference` (those of higher or
-/// equal priority, the task itself excluded) can preempt it. Integer arithmetic, exact.
+/// The worst-case response time of `task`, from its release, when every task in `interference`
+/// (those of higher or equal priority, the task itself excluded) can preempt it. Release jitter
+/// (Demand::j_ns) counts both ways: the task's own delays its start, the others' can bring one
+/// more job into a window. Integer arithmetic; exact without jitter, a safe upper bound with it.
 [[nodiscard]] ResponseTime response_time(const Demand& task, std::span<const Demand> interference);
 
 /// Bini and Baruah (2007): a bound on the response time of the first job after the critical

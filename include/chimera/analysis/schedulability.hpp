@@ -52,7 +52,10 @@ struct TaskResult {
   /// past the deadline, so the true worst case is at least that (the reason says "at least").
   bool response_is_lower_bound = false;
   bool critical = false;  // muf: in the critical set
-  std::string reason;     // one line; empty when the task meets its deadline by the CPU's test
+  /// How long after its release the task may wait for its same-rate producers on other CPUs
+  /// (analyse_configuration(); 0 on one CPU). Its response time includes the wait.
+  std::int64_t release_jitter_ns = 0;
+  std::string reason;  // one line; empty when the task meets its deadline by the CPU's test
 };
 
 struct CpuResult {
@@ -69,6 +72,10 @@ struct CpuResult {
   CpuTest test = CpuTest::kNone;
   /// edf: the test of all tasks; muf: of the critical set's tasks that fit.
   EdfTest edf;
+  /// edf, muf: the longest busy period of those tasks (longest_busy_period()), 0 if none: a job
+  /// that becomes ready ends within it, a tighter bound than D on how long a consumer on another
+  /// CPU waits for it. (rm, dm have exact response times.)
+  std::int64_t busy_period_ns = 0;
   /// Every task meets its deadline, but for muf's non-critical tasks and background tasks.
   bool feasible = true;
 };
@@ -84,7 +91,10 @@ struct ConfigurationResult {
 };
 
 /// Analyses every CPU of `cpus` (and any other that `cpu_of` names) with the tasks `cpu_of` puts
-/// there. Not real-time safe.
+/// there. A task whose same-rate producers (TaskModel::same_rate_producers) run on another CPU
+/// waits for them at each release (the same-rate rule): their response time becomes its release
+/// jitter, found by iterating to a fixed point (holistic analysis); a producer without a bound
+/// leaves its consumer without one. Not real-time safe.
 [[nodiscard]] ConfigurationResult analyse_configuration(std::span<const TaskModel> tasks, std::span<const int> cpu_of,
                                                         std::span<const int> cpus, SchedulerKind scheduler,
                                                         const AnalysisOptions& options = {});

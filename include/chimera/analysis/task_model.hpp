@@ -6,6 +6,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace chimera::analysis {
 
@@ -42,6 +43,16 @@ struct TaskModel {
   /// Position in the file: the last tie-break everywhere.
   int file_index = 0;
   WcetSource wcet_source = WcetSource::kUnknown;
+  /// The task's same-rate chain (analysis/release_order.hpp): tasks of one chain have the same
+  /// value, the file index of its first task. -1: a chain of its own. CPU assignment keeps a
+  /// chain on one CPU where it fits.
+  int chain = -1;
+  /// The file indices of the same-period tasks whose job of the same release this task waits for
+  /// before it starts (the same-rate rule). On another CPU, that wait is the task's release jitter.
+  std::vector<int> same_rate_producers;
+  /// Release jitter: how long after its release the task may wait for those producers when they
+  /// run on another CPU. analyse_configuration() finds it from their response times.
+  std::int64_t release_jitter_ns = 0;
 };
 
 /// The framework's own cost of one cycle that the module's C does not contain (release, dispatch,
@@ -60,6 +71,9 @@ struct Demand {
   std::int64_t c_ns = 0;
   std::int64_t t_ns = 0;
   std::int64_t d_ns = 0;
+  /// Release jitter J: how long after its release a job may become ready. Here, the wait for a
+  /// same-rate producer on another CPU; its job still has to finish by release + D.
+  std::int64_t j_ns = 0;
 };
 
 /// An aperiodic task without a server: it runs in the background and takes no part in analysis.

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "chimera/analysis/release_order.hpp"
 #include "chimera/analysis/task_model.hpp"
 #include "chimera/analysis/wcet_profile.hpp"
 #include "chimera/config/subsystem.hpp"
@@ -18,9 +19,11 @@ namespace chimera::analysis {
 /// `virtual_exec:` (the simulated cost the virtual clock's plan uses); otherwise it is unknown
 /// (0, WcetSource::kUnknown). A task with `server:` becomes a server model: wcet_ns = the budget,
 /// period_ns = the server's period, and the C found as above is its longest job (job_wcet_ns).
-/// `priority:` is the user priority. Not real-time safe.
+/// `priority:` is the user priority. With `order` (the file's release order) each model also gets
+/// its chain and the same-rate producers it waits for among the tasks named. Not real-time safe.
 [[nodiscard]] std::vector<TaskModel> task_models(const SubsystemSpec& spec, std::span<const std::string> task_names,
                                                  const WcetProfile* profile = nullptr,
-                                                 const WcetProfile* measured = nullptr);
+                                                 const WcetProfile* measured = nullptr,
+                                                 const ReleaseOrder* order = nullptr);
 
 }  // namespace chimera::analysis

@@ -107,7 +107,52 @@ TEST(AssignSubsystemCpus, EveryTaskOfTheFileFromItsWcetAndCpu) {
   spec.configurations.push_back(ConfigurationSpec{"one", {"a"}, {}});
   spec.configurations.push_back(ConfigurationSpec{"two", {"b", "c"}, {}});
   const std::vector<int> cpus{0, 1};
-  EXPECT_EQ(assign_subsystem_cpus(spec, cpus), (std::vector<int>{0, 1, 0}));
+  const ReleaseOrder order{.rank = {0, 0, 0}, .predecessors = {{}, {}, {}}, .chain = {0, 1, 2}};  // no data flow
+  EXPECT_EQ(assign_subsystem_cpus(spec, order, cpus), (std::vector<int>{0, 1, 0}));
+}
+
+// The issue's chain: Figure 4 with a filter and a limiter in its loop, traj -> filter -> pid ->
+// limit -> robot, all at 1 ms, C unknown. Spread task by task they went 0/1/0/1/0, and every
+// consumer waited for its producer on the other CPU at every release.
+TEST(AssignCpus, AChainOfUnknownExecutionTimesGoesWholeOnOneCpu) {
+  std::vector<TaskModel> tasks;
+  for (int i = 0; i < 5; ++i) {
+    tasks.push_back(task("link", 0, 1'000'000, i));
+    tasks.back().chain = 0;
+  }
+  tasks.push_back(task("logger", 0, 10'000'000, 5));  // another period: a chain of its own
+  tasks.back().chain = 5;
+  tasks.push_back(task("monitor", 0, 1'000'000, 6));  // same period, but fed by nobody of it
+  tasks.back().chain = 6;
+  EXPECT_EQ(assign_cpus(tasks, std::vector<int>{0, 1}, SchedulerKind::kRm), (std::vector<int>{0, 0, 0, 0, 0, 1, 1}));
+  // Without chains (each task its own), the old spread: what the issue measured.
+  for (auto& t : tasks) t.chain = -1;
+  EXPECT_EQ(assign_cpus(tasks, std::vector<int>{0, 1}, SchedulerKind::kRm), (std::vector<int>{0, 1, 0, 1, 0, 0, 1}));
+}
+
+TEST(AssignCpus, AChainFollowsItsPinnedTask) {
+  std::vector<TaskModel> tasks{task("a", 0, 10, 0), task("b", 0, 10, 1, 1), task("c", 0, 10, 2)};
+  for (auto& t : tasks) t.chain = 0;
+  EXPECT_EQ(assign_cpus(tasks, std::vector<int>{0, 1}, SchedulerKind::kEdf), (std::vector<int>{1, 1, 1}));
+  // Known C too: the pinned CPU is tried first, although CPU 0 is emptier.
+  for (auto& t : tasks) t.wcet_ns = 2;
+  EXPECT_EQ(assign_cpus(tasks, std::vector<int>{0, 1}, SchedulerKind::kEdf, kNoOverhead), (std::vector<int>{1, 1, 1}));
+}
+
+TEST(AssignCpus, AChainOfKnownExecutionTimesGoesWholeWhereItFits) {
+  // A chain of 0.3 + 0.3 and a lone 0.5: the chain (0.6) goes first, whole, on CPU 0; the 0.5 on
+  // CPU 1. Task by task it would have been 0.5 | 0.3 and then 0.3 on CPU 1: the chain split.
+  std::vector<TaskModel> tasks{task("p", 3, 10, 0), task("q", 5, 10, 1), task("c", 3, 10, 2)};
+  tasks[0].chain = tasks[2].chain = 0;
+  tasks[1].chain = 1;
+  EXPECT_EQ(assign_cpus(tasks, std::vector<int>{0, 1}, SchedulerKind::kEdf, kNoOverhead), (std::vector<int>{0, 1, 0}));
+}
+
+TEST(AssignCpus, AChainThatFitsNowhereWholeIsSplit) {
+  // 0.6 + 0.6 fits no CPU: the two go on different CPUs, and analysis counts the wait.
+  std::vector<TaskModel> tasks{task("p", 6, 10, 0), task("c", 6, 10, 1)};
+  tasks[0].chain = tasks[1].chain = 0;
+  EXPECT_EQ(assign_cpus(tasks, std::vector<int>{0, 1}, SchedulerKind::kEdf, kNoOverhead), (std::vector<int>{0, 1}));
 }
 
 TEST(AllowedCpus, TheFilesListOrEveryOnlineCpu) {

@@ -113,5 +113,27 @@ TEST(EdfTest, AgreesWithASimulationOfGeneratedSets) {
   EXPECT_GT(infeasible, 40);
 }
 
+// Release jitter J shortens a job's deadline from when it becomes ready: h(t) counts D - J
+// (Spuri 1996). Worked by hand.
+TEST(EdfTest, JitterShortensTheDeadlineTheDemandCounts) {
+  // (2, 10, 10) with J = 5 beside (4, 10, 10): h(5) = 2, h(10) = 6: feasible, by the demand test now.
+  const std::vector<Demand> waits{{2, 10, 10, 5}, {4, 10, 10}};
+  const EdfTest ok = edf_test(waits);
+  EXPECT_EQ(ok.outcome, EdfOutcome::kFeasible);
+  EXPECT_FALSE(ok.utilisation_decides);
+  EXPECT_EQ(processor_demand(waits, 5), 2);
+  // J = 9: ready 1 before its deadline with 2 to do.
+  const std::vector<Demand> late{{2, 10, 10, 9}, {4, 10, 10}};
+  const EdfTest bad = edf_test(late);
+  EXPECT_EQ(bad.outcome, EdfOutcome::kDemandExceeded);
+  EXPECT_EQ(bad.interval_ns, 1);
+  EXPECT_EQ(bad.demand_ns, 2);
+}
+
+TEST(EdfTest, JitterAtTheDeadlineLeavesNoTime) {
+  const std::vector<Demand> tasks{{3, 10, 10, 10}};
+  EXPECT_EQ(edf_test(tasks).outcome, EdfOutcome::kDemandExceeded);
+}
+
 }  // namespace
 }  // namespace chimera::analysis

@@ -111,8 +111,8 @@ TEST(ReportJson, FieldsComeFromTheResults) {
   const Json& fast = cpu0.at("tasks").at(0);  // the results' order, not the file's
   EXPECT_EQ(fast, Json::parse(R"({"name": "fast", "cpu": 0, "placed": "pinned", "criticality": "hard",
       "period_ns": 5000000, "deadline_ns": 5000000, "wcet_ns": 2000000, "wcet_source": "file",
-      "analysed_c_ns": 2000000, "response_ns": 2000000, "response_kind": "exact", "verdict": "meets",
-      "reason": ""})"));
+      "analysed_c_ns": 2000000, "response_ns": 2000000, "response_kind": "exact", "release_jitter_ns": 0,
+      "verdict": "meets", "reason": ""})"));
   const Json& slow = cpu0.at("tasks").at(1);
   EXPECT_EQ(slow.at("placed"), "assigned");
   EXPECT_EQ(slow.at("wcet_source"), "profile");

@@ -172,5 +172,45 @@ TEST(FixedPriority, RanksByPeriodOrDeadlineWithTiesShared) {
   EXPECT_EQ(fixed_priority_order(tasks, SchedulerKind::kDm), (std::vector<std::size_t>{2, 4, 1, 0}));
 }
 
+// Release jitter (Demand::j_ns): a consumer that waits for its producer on another CPU becomes
+// ready up to J after its release (analyse_configuration() finds J). Worked by hand.
+TEST(ResponseTime, OwnJitterDelaysTheStartAndCountsInTheResponse) {
+  // H (1, 4) above L (2, 10) whose job may become ready 3 after its release: w = 2 + ceil(w / 4) 1
+  // = 3, R = J + w = 6 (3 without jitter).
+  const Demand high{1, 4, 4};
+  const Demand low{2, 10, 10, 3};
+  const ResponseTime r = response_time(low, std::span<const Demand>(&high, 1));
+  EXPECT_EQ(r.outcome, RtaOutcome::kMeets);
+  EXPECT_EQ(r.response_ns, 6);
+  EXPECT_EQ(r.jobs, 1);
+}
+
+TEST(ResponseTime, AHigherTasksJitterBringsOneMoreJobIntoTheWindow) {
+  // H (1, 4) with J = 2 above L (2, 10): w = 2 + ceil((w + 2) / 4) 1: 3 -> 4 -> 4, R = 4 (3 without).
+  const Demand high{1, 4, 4, 2};
+  const Demand low{2, 10, 10};
+  EXPECT_EQ(response_time(low, std::span<const Demand>(&high, 1)).response_ns, 4);
+}
+
+TEST(ResponseTime, JitterCanPushAResponsePastTheDeadline) {
+  // L (2, 10, D 5) with J = 4 under H (1, 4): R = 4 + 3 = 7 > 5.
+  const Demand high{1, 4, 4};
+  const Demand low{2, 10, 5, 4};
+  const ResponseTime r = response_time(low, std::span<const Demand>(&high, 1));
+  EXPECT_EQ(r.outcome, RtaOutcome::kMisses);
+  EXPECT_EQ(r.response_ns, 7);
+}
+
+TEST(ResponseTime, TheBusyPeriodEndsOnlyWhenTheNextJobCannotBeReadyYet) {
+  // (3, 5) with J = 2 alone: w = 3, and 3 + 2 <= 5, so job 0 ends the busy period: R = 5 = D.
+  const Demand alone{3, 5, 5, 2};
+  const ResponseTime r = response_time(alone, {});
+  EXPECT_EQ(r.outcome, RtaOutcome::kMeets);
+  EXPECT_EQ(r.response_ns, 5);
+  // With J = 3 the job can end at 6 > 5.
+  const Demand later{3, 5, 5, 3};
+  EXPECT_EQ(response_time(later, {}).outcome, RtaOutcome::kMisses);
+}
+
 }  // namespace
 }  // namespace chimera::analysis

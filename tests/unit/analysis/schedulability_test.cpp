@@ -213,5 +213,68 @@ TEST(AnalyseConfiguration, EachCpuOnItsOwnWithGlobalIndices) {
   EXPECT_FALSE(one.feasible);
 }
 
+// A same-rate chain split over CPUs: the consumer's wait for its producer is its release jitter
+// (docs/scheduling.md, "A chain across CPUs"). p (2, 10) on CPU 0 feeds c (1, 10) on CPU 1, beside
+// x (1, 10), which reads nothing of p.
+std::vector<TaskModel> split_pair() {
+  std::vector<TaskModel> tasks{task("p", 2, 10, 0), task("c", 1, 10, 1), task("x", 1, 10, 2)};
+  tasks[1].same_rate_producers = {0};
+  return tasks;
+}
+
+TEST(AnalyseConfiguration, AConsumerOnAnotherCpuWaitsItsProducersResponseTime) {
+  const auto tasks = split_pair();
+  const std::vector<int> cpu_of{0, 1, 1};
+  const std::vector<int> cpus{0, 1};
+  // edf: no exact response time, but p's CPU is busy for at most 2 (its longest busy period) from
+  // p's release, so c waits up to 2; every task has a thread of its own, so x does not wait.
+  const auto edf = analyse_configuration(tasks, cpu_of, cpus, SchedulerKind::kEdf, kNoOverhead);
+  EXPECT_TRUE(edf.feasible);
+  EXPECT_EQ(edf.cpus[0].busy_period_ns, 2);
+  EXPECT_EQ(result_of(edf.cpus[1], 1).release_jitter_ns, 2);
+  EXPECT_EQ(result_of(edf.cpus[1], 1).verdict, Verdict::kMeets);
+  EXPECT_EQ(result_of(edf.cpus[1], 2).release_jitter_ns, 0);
+  // With c's deadline at 2 the wait leaves it no time: D - J = 0.
+  auto tight = tasks;
+  tight[1].deadline_ns = 2;
+  const auto late = analyse_configuration(tight, cpu_of, cpus, SchedulerKind::kEdf, kNoOverhead);
+  EXPECT_FALSE(late.feasible);
+  EXPECT_EQ(result_of(late.cpus[1], 1).verdict, Verdict::kCanMiss);
+
+  // rm: R(p) = 2 exactly, so c waits up to 2: R(c) = 2 + 1 + 1 (x, same priority) = 4. x shares
+  // c's thread (one CPU, one period) and runs after it, so it waits as long: R(x) = 4 too.
+  const auto rm = analyse_configuration(tasks, cpu_of, cpus, SchedulerKind::kRm, kNoOverhead);
+  EXPECT_TRUE(rm.feasible);
+  EXPECT_EQ(result_of(rm.cpus[0], 0).response_ns, 2);
+  const auto& c = result_of(rm.cpus[1], 1);
+  const auto& x = result_of(rm.cpus[1], 2);
+  EXPECT_EQ(c.release_jitter_ns, 2);
+  EXPECT_EQ(c.response_ns, 4);
+  EXPECT_EQ(c.reason, "after waiting up to 2 ns for p on another CPU");
+  EXPECT_EQ(x.release_jitter_ns, 2);
+  EXPECT_EQ(x.response_ns, 4);
+  EXPECT_EQ(x.reason, "after waiting up to 2 ns behind c, on its thread, which waits for p on another CPU");
+}
+
+TEST(AnalyseConfiguration, OnOneCpuNobodyWaits) {
+  const auto tasks = split_pair();
+  const std::vector<int> cpus{0};
+  const auto rm = analyse_configuration(tasks, std::vector<int>{0, 0, 0}, cpus, SchedulerKind::kRm, kNoOverhead);
+  for (const auto& r : rm.cpus[0].tasks) EXPECT_EQ(r.release_jitter_ns, 0);
+  EXPECT_EQ(result_of(rm.cpus[0], 1).response_ns, 4) << "the three share the priority: 2 + 1 + 1";
+}
+
+TEST(AnalyseConfiguration, AProducerWithoutABoundLeavesItsConsumerWithoutOne) {
+  auto tasks = split_pair();
+  tasks[0].wcet_ns = 11;  // p cannot meet its deadline of 10
+  const auto rm =
+      analyse_configuration(tasks, std::vector<int>{0, 1, 1}, std::vector<int>{0, 1}, SchedulerKind::kRm, kNoOverhead);
+  EXPECT_FALSE(rm.feasible);
+  EXPECT_EQ(result_of(rm.cpus[1], 1).verdict, Verdict::kCanMiss);
+  EXPECT_EQ(result_of(rm.cpus[1], 1).reason, "cannot be bounded: it waits for p on another CPU, which has no bound");
+  EXPECT_EQ(result_of(rm.cpus[1], 2).reason,
+            "cannot be bounded: c, on its thread, waits for p on another CPU, which has no bound");
+}
+
 }  // namespace
 }  // namespace chimera::analysis

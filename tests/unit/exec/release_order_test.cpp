@@ -2,7 +2,7 @@
 // released at the same instant as its producer reads the value of that instant, whatever the
 // order of the tasks in the file.
 
-#include "exec/release_order.hpp"
+#include "chimera/analysis/release_order.hpp"
 
 #include <gtest/gtest.h>
 
@@ -58,12 +58,29 @@ TEST(ReleaseOrder, RanksAndPredecessorsFollowDataFlowAndCutLoopsAtTheFirstListed
       "order.yaml", testing::test_registry());
   ASSERT_TRUE(spec.ok()) << spec.error().message;
   const auto resolution = resolve_subsystem(*spec, testing::test_registry());
-  const ReleaseOrder order = compute_release_order(resolution.subsystem);
+  const analysis::ReleaseOrder order = analysis::compute_release_order(resolution.subsystem);
   EXPECT_EQ(order.rank[1], 0);  // c, the producer, first
   EXPECT_EQ(order.rank[0], 1);  // f after it
   ASSERT_EQ(order.predecessors[0].size(), 1u);
   EXPECT_EQ(order.predecessors[0][0], 1);
   EXPECT_TRUE(order.predecessors[2].empty()) << "another period is not a predecessor";
+}
+
+TEST(ReleaseOrder, ChainsJoinTasksOfOnePeriodThatFeedEachOtherEitherWay) {
+  // c -> f (count) at 1 ms is one chain, named by its first task in the file (f, index 0); a
+  // follower at 2 ms reads `count` too but is of another period: a chain of its own; so is a
+  // counter at 1 ms whose output nobody of its period reads.
+  auto spec = load_subsystem_text(
+      "subsystem: order\ntasks:\n"
+      "  - {name: f, module: follower, period: 1ms}\n"
+      "  - {name: c, module: counter, period: 1ms}\n"
+      "  - {name: slow, module: follower, period: 2ms, rename: {copy: c2, lagged: l2, follower_cycles: fc3}}\n"
+      "  - {name: lone, module: counter, period: 1ms, rename: {count: other}}\n",
+      "order.yaml", testing::test_registry());
+  ASSERT_TRUE(spec.ok()) << spec.error().message;
+  const auto resolution = resolve_subsystem(*spec, testing::test_registry());
+  const analysis::ReleaseOrder order = analysis::compute_release_order(resolution.subsystem);
+  EXPECT_EQ(order.chain, (std::vector<int>{0, 0, 2, 3}));
 }
 
 }  // namespace
