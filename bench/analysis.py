@@ -256,39 +256,104 @@ def cycle(doc, plots):
     return out
 
 
+def _kb(v):
+    return f"{v / 1024:.1f} MiB" if v >= 1024 else f"{v:.0f} kB"
+
+
 def many_tasks(doc, plots):
     v = doc.get("tasks_1000_at_100hz_cpu_percent")
     d = _d(doc, "many_tasks") or {}
     if v is None:
         return []
+    run = doc.get("tasks_1000_cycles_run_percent")
+    missed = doc.get("tasks_1000_missed_deadlines")
+    met = v <= 10 and run is not None and run >= 99.9 and missed == 0
     out = ["## 1,000 tasks at 100 Hz", "",
            f"1,000 tasks with empty cycles, every one at 100 Hz, `cpus: [0, 1]`, real clock, SCHED_FIFO "
-           f"(`bench/many_tasks.cpp`): **{v:.1f} %** of the two cores ({d.get('cpu_percent_of_one_core', 0):.0f} % "
-           f"of one), goal <= 10 %: {'met' if v <= 10 else 'missed'}.", "",
-           "| cycles per second | CPU per cycle | user / system | context switches per second | "
-           "deadlines missed | release latency p99 (median task / worst task) |", "|---|---|---|---|---|---|",
-           f"| {d.get('cycles_per_s', 0):,.0f} (of {d.get('cycles_expected_per_s', 0):,.0f}) | "
+           f"(`bench/many_tasks.cpp`): **{v:.1f} %** of the two cores, "
+           + (f"**{run:.2f} %** of the cycles due run, **{missed:g}** deadlines missed from start"
+              if run is not None else "cycles run not measured")
+           + f". Goal <= 10 % CPU with at least 99.9 % of the cycles run and no miss: {'met' if met else 'missed'}. "
+           "Under rm the tasks of one CPU and one period share one thread, which wakes once a release "
+           "and runs them back to back (`src/exec/task_thread.cpp`).", "",
+           "| cycles per second (due) | cycles run | CPU per cycle | user / system | context switches per second "
+           "| deadlines missed (from start / in the window) | tasks ON at the end | release latency p50 / p99 / p99.9 |",
+           "|---|---|---|---|---|---|---|---|",
+           f"| {d.get('cycles_per_s', 0):,.0f} ({d.get('cycles_expected_per_s', 0):,.0f}) | "
+           f"{d.get('cycles_run_percent', 0):.2f} % | "
            f"{F(d.get('cpu_ns_per_cycle', 0))} | {d.get('user_s', 0):.2f} s / {d.get('sys_s', 0):.2f} s | "
-           f"{d.get('context_switches_per_s', 0):,.0f} | {d.get('missed_deadlines', 0)} | "
-           f"{F(d['latency_p99_ns_over_tasks']['p50'])} / {F(d['latency_p99_ns_over_tasks']['max'])} |"
-           if d.get("latency_p99_ns_over_tasks") else "", ""]
-    if v > 10:
-        per = d.get("cpu_ns_per_cycle", 0)
-        out += [f"**Missed by how much:** {v:.1f} % against 10 %, {v / 10:.1f}x.", "",
-                f"**Why.** The executive gives every task its own thread (`src/exec/real_executive.cpp`), so "
-                f"1,000 tasks at 100 Hz are 100,000 thread wake-ups a second, each a futex wait with a "
-                f"timeout, a context switch in and out, and the release bookkeeping: {F(per)} of CPU per "
-                f"cycle, {100 * d.get('sys_s', 0) / max(d.get('cpu_s', 1e-9), 1e-9):.0f} % of it in the kernel. "
-                "The framework's own part of a cycle is about 0.1 µs (the section above); the rest is the "
-                "cost of a thread per task. All 1,000 are also released at the same instant, so the last "
-                "one starts milliseconds late.", "",
-                f"**What would close it** (the executive is the lead's; not changed here): run tasks that "
-                f"share a rate and a CPU from one thread per CPU and rate, which wakes once per release and "
-                f"runs the released tasks back to back in data-flow order: 200 wake-ups a second instead "
-                f"of 100,000. At the measured framework cost per cycle that is about "
-                f"{(100_000 * (doc.get('cycle_overhead_ns') or 100) + 200 * 5_000) / 2e9 * 100:.1f} % of "
-                f"two cores. A task that needs its own priority or blocks (aperiodic servers, `sync`) would "
-                f"keep a thread of its own.", ""]
+           f"{d.get('context_switches_per_s', 0):,.0f} | {d.get('missed_deadlines_from_start', 0)} / "
+           f"{d.get('missed_deadlines_in_window', 0)} | {d.get('tasks_on_at_end', 0)} | "
+           f"{F(d.get('latency_p50_ns', 0))} / {F(d.get('latency_p99_ns', 0))} / {F(d.get('latency_p999_ns', 0))} |",
+           ""]
+    rows = d.get("scaling") or []
+    if rows:
+        out += ["**Scaling.** The same benchmark with 100 to 10,000 tasks (the others run shorter: "
+                f"{rows[0].get('measured_s', 0):.0f} s or so each). Release latency is over every release of the "
+                "window: with N tasks on a thread, the last of a release starts after the N - 1 before it. "
+                "Memory is the process's resident set once started, less before, per task (the statistics' "
+                "three histograms are most of it).", "",
+                "| tasks | CPU (2 cores) | CPU per cycle | cycles run | missed (from start) | release latency p99 "
+                "| start | memory per task (resident) |", "|---|---|---|---|---|---|---|---|"]
+        for r in rows:
+            if "error" in r:
+                out.append(f"| {r.get('tasks', 0):,} | failed: {r['error']} | | | | | | |")
+                continue
+            out.append(f"| {r.get('tasks', 0):,} | {r.get('cpu_percent_of_two_cores', 0):.1f} % | "
+                       f"{F(r.get('cpu_ns_per_cycle', 0))} | {r.get('cycles_run_percent', 0):.2f} % | "
+                       f"{r.get('missed_deadlines_from_start', 0)} | {F(r.get('latency_p99_ns', 0))} | "
+                       f"{r.get('start_s', 0):.2f} s | {_kb(r.get('memory_per_task_kb', 0))} "
+                       f"({_kb(r.get('rss_kb_running', 0))}) |")
+        out.append("")
+    if not met:
+        out += ["**Missed: why.** A miss on this shared VM is most often a scheduling stall of the VM itself "
+                "(10 ms and more, see the release latency above); each task here is hard with a module whose "
+                "`error()` does not recover, so its first miss puts it in ERROR and its later releases do not run: "
+                "the cycles run then fall by a hundred a second for each such task. Before issue 12 the start "
+                "itself made hundreds of them miss: the group start let 1,000 tasks go one round trip at a time, "
+                "and the last ones joined after their first deadline had passed.", ""]
+    return out
+
+
+def stall(doc, plots):
+    worst = doc.get("stall_recovery_periods_max")
+    d = _d(doc, "stall") or {}
+    if worst is None:
+        return []
+    bound = goals.STALL_RECOVERY_BOUND
+    errors = doc.get("stall_tasks_in_error", 0)
+    out = ["## Recovery from a stall", "",
+           f"Figure 4's five-task chain (`examples/fig4_filtered_chain.yaml`: traj -> filter -> pid -> limit -> "
+           f"robot, and the monitor, all at 1 ms) on the real clock at real-time priorities; after 2 s, "
+           f"{d.get('hog', 'a SCHED_FIFO hog')} (`bench/stall_bench.cpp`), as a VM stall would take them. "
+           f"Per task: the misses from the stall on until it is back on time, the periods from the stall's end "
+           f"until its last miss before 10 ms without one (0: on time from the first release after it; misses are "
+           f"polled every millisecond, so a figure may be one period more than the truth), and apart the misses "
+           f"after that, which are this machine's own stalls (another stall within 10 ms of the first counts as "
+           f"part of it). traj and monitor are soft (late: skip), the others hard "
+           f"(late: run, recovering from up to 100 late cycles in a row). Worst over "
+           f"{d.get('runs_per_placement', 1)} run(s) per placement: **{worst:g} periods**, {errors:g} tasks in "
+           f"ERROR; goal <= {bound} periods and none in ERROR: "
+           f"{'met' if worst <= bound and errors == 0 else 'missed'}.", "",
+           "| placement | task | CPU | missed | skipped | order timeouts | periods to be back on time | missed later "
+           "| state |",
+           "|---|---|---|---|---|---|---|---|---|"]
+    for placement, runs in sorted((d.get("placements") or {}).items()):
+        if not runs:
+            continue
+        names = sorted(runs[0]["tasks"])
+        for name in names:
+            per = [r["tasks"][name] for r in runs if name in r["tasks"]]
+            def span(key):
+                vals = [p[key] for p in per]
+                return f"{min(vals)}" if min(vals) == max(vals) else f"{min(vals)}–{max(vals)}"
+            out.append(f"| {placement} | {name} | {per[0]['cpu']} | {span('missed')} | {span('skipped')} | "
+                       f"{span('order_timeouts')} | {span('recovery_periods')} | {span('missed_later')} | "
+                       f"{', '.join(sorted({p['state'] for p in per}))} |")
+    out += ["", "The stall's 40 releases are late by construction: a hard task runs each of them late (39 or 40 "
+            "misses), a soft one skips those whose deadline has passed. What the policy bounds is what comes "
+            "after: docs/scheduling.md, \"After a stall\". The same policy is tested exactly on the virtual "
+            "clock (`tests/unit/exec/stall_recovery_test.cpp`).", ""]
     return out
 
 
@@ -379,7 +444,7 @@ def pending(doc, plots):
 
 def sections(doc, plots):
     out = []
-    for section in (svt_uncontended, svt_contended, cycle, release, ipc, many_tasks, policies, switching, virtual,
-                    pending):
+    for section in (svt_uncontended, svt_contended, cycle, release, ipc, many_tasks, stall, policies, switching,
+                    virtual, pending):
         out += section(doc, plots)
     return out

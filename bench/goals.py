@@ -50,10 +50,19 @@ KEYS = [
     Key("switch_commit_latency_ns_p50", "ns", "request to commit of a switch at a cycle boundary, p50"),
     Key("switch_commit_latency_ns_p99", "ns", "request to commit of a switch at a cycle boundary, p99"),
     Key("tasks_1000_at_100hz_cpu_percent", "%", "framework CPU, 1,000 empty tasks at 100 Hz, share of 2 cores"),
+    Key("tasks_1000_cycles_run_percent", "%", "1,000 tasks at 100 Hz: cycles run, share of the releases due"),
+    Key("tasks_1000_missed_deadlines", "", "1,000 tasks at 100 Hz: deadlines missed, from start"),
+    Key("tasks_1000_latency_p99_ns", "ns", "1,000 tasks at 100 Hz: release latency p99 over every release"),
+    Key("stall_recovery_periods_max", "periods",
+        "five-task chain at 1 ms, 40 ms stall of both CPUs: periods after it until every task is on time (worst)"),
+    Key("stall_tasks_in_error", "", "the same: tasks in ERROR after the stall (all runs and placements)"),
     Key("virtual_clock_speedup_fig4", "x", "simulated seconds per wall second, Figure 4 on the virtual clock"),
 ]
 
 KEY_NAMES = [k.name for k in KEYS]
+
+# docs/scheduling.md, "After a stall": the bound the stall benchmark is held to.
+STALL_RECOVERY_BOUND = 5
 
 
 @dataclass
@@ -121,10 +130,25 @@ GOALS = [
          lambda r: f"{r['switch_lost_cycles']:g} lost" + (
              f"; commit latency p50 {_fmt(r['switch_commit_latency_ns_p50'])}, p99 "
              f"{_fmt(r['switch_commit_latency_ns_p99'])}" if _have(r, "switch_commit_latency_ns_p99") else "")),
-    Goal("1,000 tasks at 100 Hz on 2 cores with <= 10% framework CPU",
-         ["tasks_1000_at_100hz_cpu_percent"],
-         lambda r: r["tasks_1000_at_100hz_cpu_percent"] <= 10 if _have(r, "tasks_1000_at_100hz_cpu_percent") else None,
-         lambda r: _fmt(r["tasks_1000_at_100hz_cpu_percent"], "%")),
+    # Met only when the work the CPU figure names was done: every release ran, none late.
+    Goal("1,000 tasks at 100 Hz on 2 cores with <= 10% framework CPU (>= 99.9 % of the cycles run, no miss)",
+         ["tasks_1000_at_100hz_cpu_percent", "tasks_1000_cycles_run_percent", "tasks_1000_missed_deadlines"],
+         lambda r: (r["tasks_1000_at_100hz_cpu_percent"] <= 10 and r["tasks_1000_cycles_run_percent"] >= 99.9
+                    and r["tasks_1000_missed_deadlines"] == 0)
+         if _have(r, "tasks_1000_at_100hz_cpu_percent", "tasks_1000_cycles_run_percent",
+                  "tasks_1000_missed_deadlines") else None,
+         lambda r: (f"{_fmt(r['tasks_1000_at_100hz_cpu_percent'], '%')} CPU; "
+                    f"{r['tasks_1000_cycles_run_percent']:.2f} % of the cycles run; "
+                    f"{r['tasks_1000_missed_deadlines']:g} missed"
+                    + (f"; release latency p99 {_fmt(r['tasks_1000_latency_p99_ns'])}"
+                       if _have(r, "tasks_1000_latency_p99_ns") else ""))),
+    Goal("after a 40 ms stall of both CPUs, every task of a 1 ms chain back on time within "
+         f"{STALL_RECOVERY_BOUND} periods, none in ERROR",
+         ["stall_recovery_periods_max", "stall_tasks_in_error"],
+         lambda r: (r["stall_recovery_periods_max"] <= STALL_RECOVERY_BOUND and r["stall_tasks_in_error"] == 0)
+         if _have(r, "stall_recovery_periods_max", "stall_tasks_in_error") else None,
+         lambda r: (f"worst {r['stall_recovery_periods_max']:g} periods; "
+                    f"{r['stall_tasks_in_error']:g} tasks in ERROR")),
     Goal("virtual-clock runs of Figure 4 at >= 100x real time",
          ["virtual_clock_speedup_fig4"],
          lambda r: r["virtual_clock_speedup_fig4"] >= 100 if _have(r, "virtual_clock_speedup_fig4") else None,

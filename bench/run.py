@@ -111,6 +111,34 @@ def run_fragment(exe, ctx, extra=(), timeout_s=300):
     return frag
 
 
+# ---- many tasks ------------------------------------------------------------------------------
+
+SCALING_TASKS = (100, 1000, 5000, 10000)
+
+
+def run_many_tasks(build, ctx):
+    """1,000 tasks for the goal, then the scaling table: 100, 5,000 and 10,000 tasks (shorter runs)."""
+    exe = build / "bench" / "many_tasks"
+    frag = run_fragment(exe, ctx, ["--tasks", "1000"], timeout_s=300)
+    rows = {}
+    if "error" not in frag.get("details", {}):
+        rows[1000] = dict(frag["details"])
+    seconds = "3" if ctx.quick else "10"
+    for n in SCALING_TASKS:
+        if n == 1000:
+            continue
+        out = ctx.work / f"many_tasks_{n}.json"
+        cmd = [str(exe), "--out", str(out), "--tasks", str(n), "--seconds", seconds]
+        ctx.log(" ".join(cmd))
+        proc = subprocess.run(cmd, stdout=ctx.logfile, stderr=subprocess.STDOUT, timeout=300)
+        if proc.returncode == 0 and out.exists():
+            rows[n] = json.loads(out.read_text()).get("details", {})
+        else:
+            rows[n] = {"tasks": n, "error": f"exit {proc.returncode} (see {ctx.logpath})"}
+    frag.setdefault("details", {})["scaling"] = [rows[n] for n in SCALING_TASKS if n in rows]
+    return frag
+
+
 # ---- the virtual clock ----------------------------------------------------------------------
 
 def run_virtual_clock(build, ctx):
@@ -156,7 +184,11 @@ PROGRAMS = [
     Program("release_latency", "release_latency", "release latency vs cyclictest",
             ["release_latency_ns_p50", "release_latency_ns_p99", "cyclictest_latency_ns_p50",
              "cyclictest_latency_ns_p99", "release_latency_p50_ratio", "release_latency_p99_ratio"]),
-    Program("many_tasks", "many_tasks", "1,000 tasks at 100 Hz", ["tasks_1000_at_100hz_cpu_percent"]),
+    Program("many_tasks", "many_tasks", "1,000 tasks at 100 Hz, and 100 to 10,000",
+            ["tasks_1000_at_100hz_cpu_percent", "tasks_1000_cycles_run_percent", "tasks_1000_missed_deadlines",
+             "tasks_1000_latency_p99_ns"], run=run_many_tasks, timeout_s=900),
+    Program("stall", "stall_bench", "Figure 4's five-task chain after a 40 ms stall of both CPUs",
+            ["stall_recovery_periods_max", "stall_tasks_in_error"]),
     Program("virtual_clock", "apps/chimera/chimera", "Figure 4 on the virtual clock",
             ["virtual_clock_speedup_fig4"], run=run_virtual_clock),
     Program("policies", "policy_bench", "rm, edf and muf on the real clock: deadlines missed", []),

@@ -36,6 +36,12 @@ class MyModule final : public chimera::Module {
     return chimera::Status::ok();
   }
 
+  // No error() here: the default does not recover. A hard task (the default criticality) made
+  // from this module goes to ERROR at its first missed deadline, and `chimera run` exits 1. If a
+  // late cycle is only late, say criticality: soft in the subsystem file, or recover here with
+  // TimingFaultTolerance (chimera/module/fault_tolerance.hpp); docs/writing-modules.md, "What
+  // happens at a missed deadline", says how to choose.
+
   // Real-time: no allocation, no exception, no lock, no formatting.
   chimera::Status cycle() override {
     if (!u_.has_data()) return chimera::Status::ok();

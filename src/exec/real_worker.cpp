@@ -17,6 +17,18 @@
 namespace chimera {
 
 namespace {
+// How long a late consumer spins for a producer on another CPU before it sleeps (see
+// wait_for_predecessors): a few cross-CPU wake-ups' worth on this kind of machine.
+constexpr std::int64_t kCatchUpSpinNs = 50'000;
+
+inline void cpu_relax() noexcept {
+#if defined(__x86_64__) || defined(__i386__)
+  __builtin_ia32_pause();
+#elif defined(__aarch64__)
+  asm volatile("yield");
+#endif
+}
+
 // Release indices are compared modulo 2^32 (the futex word is 32 bits).
 bool reached(std::uint32_t completed_plus_one, std::int64_t k) {
   return static_cast<std::int32_t>(completed_plus_one - static_cast<std::uint32_t>(k + 1)) >= 0;
@@ -206,6 +218,8 @@ void Worker::act() {
     schedule.k += static_cast<std::int64_t>(late.skipped);
     task->skip_releases(late.skipped, now);
     precedence.scheduled.store(schedule.k, std::memory_order_release);  // release: as in prepare()
+    // A successor asleep on one of the releases skipped must look again now, not at its bound.
+    if (precedence.waiters.load(std::memory_order_seq_cst) != 0) detail::futex_wake_all(precedence.completed);
     if (task->state() != TaskState::kOn || now < late.next_release) return;
   }
   const std::int64_t release_abs = epoch + schedule.k * period;
@@ -217,6 +231,10 @@ void Worker::act() {
   precedence.completed.store(static_cast<std::uint32_t>(schedule.k + 1), std::memory_order_seq_cst);
   if (precedence.waiters.load(std::memory_order_seq_cst) != 0) detail::futex_wake_all(precedence.completed);
   ++schedule.k;  // under late: run a late cycle runs late; the next release stays on the absolute grid
+  // Successors learn at once which release comes next (not at this thread's next pass, which other
+  // members may delay): a consumer tells a producer that is behind from one that is not by it.
+  if (task->state() == TaskState::kOn && (schedule.leave_seq == 0 || epoch + schedule.k * period < schedule.leave_at))
+    precedence.scheduled.store(schedule.k, std::memory_order_release);  // release: as in prepare()
 }
 
 void Worker::run_aperiodic() {
@@ -258,6 +276,11 @@ void Worker::run_aperiodic() {
 void Worker::wait_for_predecessors(std::int64_t release, std::int64_t release_abs) const {
   const std::int64_t give_up =
       release_policy::producer_wait_until(release_abs, monotonic_ns(), task->spec().deadline_ns);
+  bool behind = false;  // a producer had an earlier release still to run: not waited for
+  // A late job (a period or more behind its release) spins briefly for a producer on another CPU
+  // before it sleeps; an on-time one sleeps at once (a spin would cost CPU every period).
+  const std::int64_t now = monotonic_ns();
+  const std::int64_t spin_until = now - release_abs >= task->period_ns() ? now + kCatchUpSpinNs : 0;
   for (Worker* p : predecessors) {
     // A producer on this thread has had its turn in this pass (it comes first in data-flow
     // order); if it has not run the release, it is behind and can only catch up once we return:
@@ -265,14 +288,28 @@ void Worker::wait_for_predecessors(std::int64_t release, std::int64_t release_ab
     if (p->thread == thread) continue;
     for (;;) {
       // acquire: its cycle's outputs are published
-      const bool completed = reached(p->precedence.completed.load(std::memory_order_acquire), release);
+      const std::uint32_t done = p->precedence.completed.load(std::memory_order_acquire);
+      const bool completed = reached(done, release);
+      const bool completed_previous = reached(done, release - 1);
       const std::int64_t joins = p->precedence.joining_k.load(std::memory_order_acquire);  // acquire: the commit's
       const bool joining = joins >= 0 && joins <= release;
       // A joining producer is waited for at its first release as if it were ON already.
       const bool on = joining || p->task->state() == TaskState::kOn;
       // acquire: pairs with its store of the release it is about to run
       const std::int64_t next = joining ? joins : p->precedence.scheduled.load(std::memory_order_acquire);
-      if (!release_policy::waits_for_producer(on, completed, next, release)) break;
+      if (!release_policy::waits_for_producer(on, completed, completed_previous, next, release)) {
+        behind = behind || release_policy::producer_behind(on, completed, completed_previous, next, release);
+        break;
+      }
+      if (spin_until > 0 && p->cpu != cpu) {
+        // Catching up: the producer, on another CPU, is running the releases just before ours
+        // one after another; a futex sleep and wake per release would cost more than the job.
+        while (!reached(p->precedence.completed.load(std::memory_order_acquire), release) &&  // acquire: as above
+               monotonic_ns() < spin_until) {
+          cpu_relax();
+        }
+        if (reached(p->precedence.completed.load(std::memory_order_acquire), release)) continue;  // acquire: as above
+      }
       p->precedence.waiters.fetch_add(1, std::memory_order_seq_cst);  // seq_cst: Dekker with the producer (see act)
       const std::uint32_t c = p->precedence.completed.load(std::memory_order_seq_cst);
       bool in_time = true;
@@ -284,6 +321,7 @@ void Worker::wait_for_predecessors(std::int64_t release, std::int64_t release_ab
       }
     }
   }
+  if (behind) task->record_order_timeout();  // this release runs without a producer's value of it
 }
 
 }  // namespace chimera

@@ -54,11 +54,26 @@ constexpr LateReleases late_releases(LatePolicy late, std::int64_t next_release,
 
 /// The same-rate rule (analysis/release_order.hpp): a consumer's job of release `release` waits for a
 /// same-period producer that is ON (or joining at or before that release), has not completed
-/// that release, and will run it: its next release to run is at or before it. A producer that
-/// turned on later, or skipped that release, is not waited for. Releases in one unit (index or ns).
-constexpr bool waits_for_producer(bool producer_on, bool producer_completed_it, std::int64_t producer_next,
-                                  std::int64_t release) noexcept {
-  return producer_on && !producer_completed_it && producer_next >= 0 && producer_next <= release;
+/// that release, and will run it next: its next release to run is that one (or its last
+/// completed is the one before, its next not published yet). A producer that turned on later,
+/// skipped that release, or is behind (it still has an earlier release to run: it is catching
+/// up after a stall, or is stalled itself) is not waited for: the consumer runs at once with the
+/// producer's latest value. Waiting for a producer that is behind would cost its whole backlog,
+/// and with several consumers on one thread one stall would cascade (docs/scheduling.md, "After
+/// a stall"). Releases in one unit (index or ns).
+constexpr bool waits_for_producer(bool producer_on, bool producer_completed_it, bool producer_completed_previous,
+                                  std::int64_t producer_next, std::int64_t release) noexcept {
+  if (!producer_on || producer_completed_it || producer_next < 0 || producer_next > release) return false;
+  return producer_next == release || producer_completed_previous;
+}
+
+/// Whether the producer is behind the consumer's release: ON, with an earlier release still to
+/// run before this one. The consumer then runs without this release's value (counted in its
+/// order_timeouts, as a wait that gave up is). Arguments as for waits_for_producer.
+constexpr bool producer_behind(bool producer_on, bool producer_completed_it, bool producer_completed_previous,
+                               std::int64_t producer_next, std::int64_t release) noexcept {
+  return producer_on && !producer_completed_it && producer_next >= 0 && producer_next < release &&
+         !producer_completed_previous;
 }
 
 /// How long at most a consumer waits for its producers: until half its relative deadline after

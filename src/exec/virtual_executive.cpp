@@ -47,8 +47,24 @@ bool VirtualExecutive::blocked_by_producer(std::size_t i) const {
     const Slot& ps = slots_[static_cast<std::size_t>(p)];
     const bool on = tasks_[static_cast<std::size_t>(p)]->state() == TaskState::kOn;
     const bool completed = ps.last_done_release_ns >= s.job.release_ns;
+    const bool completed_previous = ps.last_done_release_ns >= s.job.release_ns - tasks_[i]->period_ns();
     const std::int64_t next = ps.job.active ? ps.job.release_ns : ps.next_release_ns;  // what it runs next
-    return release_policy::waits_for_producer(on, completed, next, s.job.release_ns);
+    return release_policy::waits_for_producer(on, completed, completed_previous, next, s.job.release_ns);
+  });
+}
+
+bool VirtualExecutive::starts_without_a_producer(std::size_t i) const {
+  // As the real clock counts it: a job that starts while a producer it would wait for has not
+  // run its release (the wait's bound passed), or while a producer is behind.
+  const Slot& s = slots_[i];
+  return std::ranges::any_of(order_.predecessors[i], [&](int p) {
+    const Slot& ps = slots_[static_cast<std::size_t>(p)];
+    const bool on = tasks_[static_cast<std::size_t>(p)]->state() == TaskState::kOn;
+    const bool completed = ps.last_done_release_ns >= s.job.release_ns;
+    const bool completed_previous = ps.last_done_release_ns >= s.job.release_ns - tasks_[i]->period_ns();
+    const std::int64_t next = ps.job.active ? ps.job.release_ns : ps.next_release_ns;
+    return release_policy::waits_for_producer(on, completed, completed_previous, next, s.job.release_ns) ||
+           release_policy::producer_behind(on, completed, completed_previous, next, s.job.release_ns);
   });
 }
 
@@ -78,6 +94,19 @@ void VirtualExecutive::release_periodic(std::size_t i) {
   const std::int64_t release = s.next_release_ns;
   s.job = Job{true, false, release, 0, 0, release_policy::producer_wait_until(release, now_ns_, t.spec().deadline_ns)};
   s.next_release_ns += period;
+}
+
+void VirtualExecutive::drop_if_too_late(std::size_t i) {
+  // Under late: skip a release is judged when its job could start, as on the real clock, where
+  // the task's thread judges it when it runs again: a job released on time but kept from
+  // starting (a stall, a more urgent task) past its deadline is not started; release_periodic
+  // then skips it with the others whose deadline has passed.
+  const Task& t = *tasks_[i];
+  Slot& s = slots_[i];
+  if (!s.job.active || s.job.started || t.spec().late != LatePolicy::kSkip || t.spec().deadline_ns <= 0) return;
+  if (now_ns_ <= s.job.release_ns + t.spec().deadline_ns) return;
+  s.next_release_ns = s.job.release_ns;
+  s.job = Job{};
 }
 
 void VirtualExecutive::poll_triggers() {
@@ -124,6 +153,16 @@ void VirtualExecutive::finish(std::size_t i) {
   if (t.periodic() && t.state() != TaskState::kOn) s.next_release_ns = -1;
 }
 
+void VirtualExecutive::start_job(std::size_t i) {
+  Slot& s = slots_[i];
+  s.job.started = true;
+  s.job_start_ns = now_ns_;
+  if (tasks_[i]->periodic() && starts_without_a_producer(i)) tasks_[i]->record_order_timeout();
+  const std::int64_t cost = tasks_[i]->begin_job(s.job.release_ns, now_ns_);
+  s.job.exec_ns = std::max<std::int64_t>(cost, 0);
+  s.job.remaining_ns = tasks_[i]->state() == TaskState::kOn ? s.job.exec_ns : 0;
+}
+
 void VirtualExecutive::dispatch() {
   for (;;) {
     // The most urgent ready job of each CPU, and among the CPUs whose choice changes, the most
@@ -149,13 +188,7 @@ void VirtualExecutive::dispatch() {
     const auto i = static_cast<std::size_t>(pick);
     Slot& s = slots_[i];
     running_[static_cast<std::size_t>(cpu_slot_[i])] = pick;  // preempts whatever ran there
-    if (!s.job.started) {
-      s.job.started = true;
-      s.job_start_ns = now_ns_;
-      const std::int64_t cost = tasks_[i]->begin_job(s.job.release_ns, now_ns_);
-      s.job.exec_ns = std::max<std::int64_t>(cost, 0);
-      s.job.remaining_ns = tasks_[i]->state() == TaskState::kOn ? s.job.exec_ns : 0;
-    }
+    if (!s.job.started) start_job(i);
     if (s.job.remaining_ns <= 0) {
       finish(i);
       poll_triggers();  // what it published may wake an aperiodic task at this same instant
@@ -168,7 +201,9 @@ std::int64_t VirtualExecutive::next_event_after_dispatch() const {
   for (std::size_t i = 0; i < tasks_.size(); ++i) {
     const Slot& s = slots_[i];
     const Task& task = *tasks_[i];
-    if (!s.job.active && s.next_release_ns >= 0) t = std::min(t, s.next_release_ns);
+    // A release already past (late: run catching up after a stall, one job at a time) is due now:
+    // never a step back in time.
+    if (!s.job.active && s.next_release_ns >= 0) t = std::min(t, std::max(s.next_release_ns, now_ns_));
     if (s.job.active && !s.job.started && s.job.wait_until_ns > now_ns_) t = std::min(t, s.job.wait_until_ns);
     t = std::min(t, s.server.next_refill());
     const bool watching = !task.periodic() && task.state() == TaskState::kOn && task.trigger().fd >= 0;
@@ -191,8 +226,11 @@ void VirtualExecutive::step() {
   refill_servers();
   for (const int r : running_)
     if (r >= 0 && slots_[static_cast<std::size_t>(r)].job.remaining_ns <= 0) finish(static_cast<std::size_t>(r));
-  for (std::size_t i = 0; i < tasks_.size(); ++i)
-    if (tasks_[i]->periodic()) release_periodic(i);
+  for (std::size_t i = 0; i < tasks_.size(); ++i) {
+    if (!tasks_[i]->periodic()) continue;
+    drop_if_too_late(i);
+    release_periodic(i);
+  }
   poll_triggers();
   dispatch();
 }

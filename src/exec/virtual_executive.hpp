@@ -80,9 +80,12 @@ class VirtualExecutive final : public Executive {
   [[nodiscard]] JobUrgency urgency_of(std::size_t i) const;
   [[nodiscard]] bool ready(std::size_t i) const;
   [[nodiscard]] bool blocked_by_producer(std::size_t i) const;
+  [[nodiscard]] bool starts_without_a_producer(std::size_t i) const;
+  void drop_if_too_late(std::size_t i);
   void release_periodic(std::size_t i);
   void poll_triggers();
   void refill_servers();
+  void start_job(std::size_t i);
   void dispatch();
   void step();
   void finish(std::size_t i);

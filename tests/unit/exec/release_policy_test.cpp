@@ -67,14 +67,17 @@ TEST(ReleasePolicyLate, ALongStallIsCountedAtOnce) {
   EXPECT_EQ(late.next_release, 999'999'999);
 }
 
-TEST(ReleasePolicySameRate, AConsumerWaitsOnlyForAProducerThatWillRunItsRelease) {
+TEST(ReleasePolicySameRate, AConsumerWaitsOnlyForAProducerThatWillRunItsReleaseNext) {
   const std::int64_t release = 7;
-  EXPECT_TRUE(waits_for_producer(true, false, 7, release)) << "about to run this release";
-  EXPECT_TRUE(waits_for_producer(true, false, 6, release)) << "behind: it will get to it";
-  EXPECT_FALSE(waits_for_producer(true, true, 7, release)) << "done already";
-  EXPECT_FALSE(waits_for_producer(false, false, 7, release)) << "not ON";
-  EXPECT_FALSE(waits_for_producer(true, false, 8, release)) << "turned on after it, or skipped it";
-  EXPECT_FALSE(waits_for_producer(true, false, -1, release)) << "not released at all";
+  EXPECT_TRUE(waits_for_producer(true, false, false, 7, release)) << "about to run this release";
+  EXPECT_TRUE(waits_for_producer(true, false, true, 7, release)) << "about to run it, the one before done";
+  EXPECT_TRUE(waits_for_producer(true, false, true, 6, release)) << "done with 6, its next not published yet";
+  EXPECT_FALSE(waits_for_producer(true, false, false, 6, release)) << "behind: 6 still to run, then 7";
+  EXPECT_FALSE(waits_for_producer(true, false, false, 2, release)) << "behind: catching up after a stall";
+  EXPECT_FALSE(waits_for_producer(true, true, true, 7, release)) << "done already";
+  EXPECT_FALSE(waits_for_producer(false, false, true, 7, release)) << "not ON";
+  EXPECT_FALSE(waits_for_producer(true, false, true, 8, release)) << "turned on after it, or skipped it";
+  EXPECT_FALSE(waits_for_producer(true, false, true, -1, release)) << "not released at all";
 }
 
 TEST(ReleasePolicySameRate, TheWaitIsBoundedByHalfTheDeadlineFromWhenItStarts) {
