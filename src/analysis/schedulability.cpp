@@ -160,46 +160,77 @@ void analyse_edf(std::span<const TaskModel> tasks, const std::vector<std::option
 
 void analyse_muf(std::span<const TaskModel> tasks, const std::vector<std::optional<Demand>>& demands,
                  const AnalysisOptions& options, CpuResult& cpu) {
-  const CriticalSet set = muf_critical_set(tasks, options);
-  const auto unfit = [&](std::size_t i) {
-    return std::find(set.unfit_hard.begin(), set.unfit_hard.end(), i) != set.unfit_hard.end();
-  };
+  // The critical set is the one the run builds, from the C it knows before it starts (wcet:,
+  // virtual_exec:) and its overhead; analysis then checks that set with its own C (the profile's,
+  // a measurement), so that the set it names is the one the executive orders jobs by
+  // (analysis/muf.hpp). Models made by hand, which no run shares, are admitted as they are.
+  const bool from_a_file =
+      std::any_of(tasks.begin(), tasks.end(), [](const TaskModel& t) { return t.run_wcet_ns.has_value(); });
+  const CriticalSet set = from_a_file ? runtime_critical_set(tasks) : muf_critical_set(tasks, options);
   const auto order = muf_admission_order(tasks);
-  std::vector<Demand> fitting;
-  for (const std::size_t i : order)
-    if (set.critical[i] && !unfit(i)) fitting.push_back(*demands[i]);
-  cpu.edf = edf_test(fitting);
+  std::vector<Demand> critical_demands;
+  std::string unknown;  // a critical task whose C analysis does not know either
+  for (const std::size_t i : order) {
+    if (!set.critical[i]) continue;
+    if (demands[i])
+      critical_demands.push_back(*demands[i]);
+    else if (unknown.empty())
+      unknown = tasks[i].name;
+  }
+  cpu.edf = edf_test(critical_demands);
+  const bool holds = unknown.empty() && cpu.edf.outcome == EdfOutcome::kFeasible;
 
   std::vector<TaskResult> critical;
   std::vector<TaskResult> others;
   for (const std::size_t i : order) {
+    const TaskModel& t = tasks[i];
     TaskResult r;
     r.index = i;
     r.demand = demands[i];
     r.critical = set.critical[i];
-    if (r.critical && !unfit(i)) {
-      r.verdict = Verdict::kMeets;
-      r.response_ns = r.demand->d_ns;
-      r.response_is_bound = true;
-    } else if (r.critical) {
+    if (r.critical) {
       if (!r.demand) {
-        r.reason = "hard, " + unknown_reason(tasks[i]);
+        r.reason = (t.hard ? "hard, " : "") + unknown_reason(t);
+      } else if (!unknown.empty()) {
+        r.reason = fmt::format("cannot be bounded: {} in the critical set has an unknown execution time", unknown);
+      } else if (holds) {
+        r.verdict = Verdict::kMeets;
+        r.response_ns = r.demand->d_ns;
+        r.response_is_bound = true;
       } else {
-        std::vector<Demand> with = fitting;
-        with.push_back(*r.demand);
-        r.reason = "hard, but does not fit in the critical set: with it, " + edf_failure_reason(edf_test(with));
+        r.reason = "the critical set fails its EDF test: " + edf_failure_reason(cpu.edf);
       }
+    } else if (t.hard) {
+      // Left out by the run: with the C it knows, the task does not fit beside those admitted.
+      cpu.hard_left_out = true;
+      std::string why;
+      if (r.demand) {
+        std::vector<Demand> with = critical_demands;
+        with.push_back(*r.demand);
+        why = edf_failure_reason(edf_test(with));
+      }
+      r.reason = !why.empty() ? "hard, but does not fit in the critical set: with it, " + why
+                              : fmt::format(
+                                    "hard, but does not fit in the critical set with the C a run knows "
+                                    "(wcet: or virtual_exec:, {} of overhead)",
+                                    exact_duration_text(kDefaultOverheadNs));
     } else {
       r.verdict = Verdict::kNoGuarantee;
-      r.reason = !set.feasible ? "outside the critical set: the hard tasks already do not fit"
-                 : !r.demand   ? "outside the critical set: " + unknown_reason(tasks[i])
-                               : "outside the critical set, which admits the shortest periods first while they fit";
+      r.reason = !set.unfit_hard.empty() ? "outside the critical set: a hard task does not fit, so no soft task is"
+                                           " admitted"
+                 : !set.unknown_hard.empty()
+                     ? "outside the critical set: a hard task's execution time is not known before the run (give it "
+                       "a wcet), so no soft task is admitted"
+                 : run_known_wcet(t) <= 0 ? "outside the critical set: its execution time is not known before the run "
+                                            "(give the task a wcet)"
+                                          : "outside the critical set, which admits the shortest periods first while "
+                                            "they fit";
     }
     (r.critical ? critical : others).push_back(std::move(r));
   }
   for (auto& r : critical) cpu.tasks.push_back(std::move(r));
   for (auto& r : others) cpu.tasks.push_back(std::move(r));
-  cpu.feasible = set.feasible;
+  cpu.feasible = holds && !cpu.hard_left_out;
 }
 
 }  // namespace
