@@ -158,6 +158,31 @@ void analyse_edf(std::span<const TaskModel> tasks, const std::vector<std::option
   }
 }
 
+// Why a soft task is outside MUF's critical set.
+std::string outside_reason(const CriticalSet& set, const TaskModel& t) {
+  if (!set.unfit_hard.empty()) return "outside the critical set: a hard task does not fit, so no soft task is admitted";
+  if (!set.unknown_hard.empty())
+    return "outside the critical set: a hard task's execution time is not known before the run (give it a wcet), so "
+           "no soft task is admitted";
+  if (run_known_wcet(t) <= 0)
+    return "outside the critical set: its execution time is not known before the run (give the task a wcet)";
+  return "outside the critical set, which admits the shortest periods first while they fit";
+}
+
+// Why a hard task is outside MUF's critical set: with the C the run knows it does not fit.
+std::string left_out_reason(const std::vector<Demand>& critical_demands, const std::optional<Demand>& demand) {
+  if (demand) {
+    std::vector<Demand> with = critical_demands;
+    with.push_back(*demand);
+    const std::string why = edf_failure_reason(edf_test(with));
+    if (!why.empty()) return "hard, but does not fit in the critical set: with it, " + why;
+  }
+  return fmt::format(
+      "hard, but does not fit in the critical set with the C a run knows (wcet: or virtual_exec:, {} "
+      "of overhead)",
+      exact_duration_text(kDefaultOverheadNs));
+}
+
 void analyse_muf(std::span<const TaskModel> tasks, const std::vector<std::optional<Demand>>& demands,
                  const AnalysisOptions& options, CpuResult& cpu) {
   // The critical set is the one the run builds, from the C it knows before it starts (wcet:,
@@ -171,11 +196,8 @@ void analyse_muf(std::span<const TaskModel> tasks, const std::vector<std::option
   std::vector<Demand> critical_demands;
   std::string unknown;  // a critical task whose C analysis does not know either
   for (const std::size_t i : order) {
-    if (!set.critical[i]) continue;
-    if (demands[i])
-      critical_demands.push_back(*demands[i]);
-    else if (unknown.empty())
-      unknown = tasks[i].name;
+    if (set.critical[i] && demands[i]) critical_demands.push_back(*demands[i]);
+    if (set.critical[i] && !demands[i] && unknown.empty()) unknown = tasks[i].name;
   }
   cpu.edf = edf_test(critical_demands);
   const bool holds = unknown.empty() && cpu.edf.outcome == EdfOutcome::kFeasible;
@@ -188,43 +210,20 @@ void analyse_muf(std::span<const TaskModel> tasks, const std::vector<std::option
     r.index = i;
     r.demand = demands[i];
     r.critical = set.critical[i];
-    if (r.critical) {
-      if (!r.demand) {
-        r.reason = (t.hard ? "hard, " : "") + unknown_reason(t);
-      } else if (!unknown.empty()) {
-        r.reason = fmt::format("cannot be bounded: {} in the critical set has an unknown execution time", unknown);
-      } else if (holds) {
-        r.verdict = Verdict::kMeets;
-        r.response_ns = r.demand->d_ns;
-        r.response_is_bound = true;
-      } else {
-        r.reason = "the critical set fails its EDF test: " + edf_failure_reason(cpu.edf);
-      }
-    } else if (t.hard) {
-      // Left out by the run: with the C it knows, the task does not fit beside those admitted.
-      cpu.hard_left_out = true;
-      std::string why;
-      if (r.demand) {
-        std::vector<Demand> with = critical_demands;
-        with.push_back(*r.demand);
-        why = edf_failure_reason(edf_test(with));
-      }
-      r.reason = !why.empty() ? "hard, but does not fit in the critical set: with it, " + why
-                              : fmt::format(
-                                    "hard, but does not fit in the critical set with the C a run knows "
-                                    "(wcet: or virtual_exec:, {} of overhead)",
-                                    exact_duration_text(kDefaultOverheadNs));
+    if (!r.critical) {
+      cpu.hard_left_out = cpu.hard_left_out || t.hard;
+      if (!t.hard) r.verdict = Verdict::kNoGuarantee;
+      r.reason = t.hard ? left_out_reason(critical_demands, r.demand) : outside_reason(set, t);
+    } else if (!r.demand) {
+      r.reason = (t.hard ? "hard, " : "") + unknown_reason(t);
+    } else if (!unknown.empty()) {
+      r.reason = fmt::format("cannot be bounded: {} in the critical set has an unknown execution time", unknown);
+    } else if (holds) {
+      r.verdict = Verdict::kMeets;
+      r.response_ns = r.demand->d_ns;
+      r.response_is_bound = true;
     } else {
-      r.verdict = Verdict::kNoGuarantee;
-      r.reason = !set.unfit_hard.empty() ? "outside the critical set: a hard task does not fit, so no soft task is"
-                                           " admitted"
-                 : !set.unknown_hard.empty()
-                     ? "outside the critical set: a hard task's execution time is not known before the run (give it "
-                       "a wcet), so no soft task is admitted"
-                 : run_known_wcet(t) <= 0 ? "outside the critical set: its execution time is not known before the run "
-                                            "(give the task a wcet)"
-                                          : "outside the critical set, which admits the shortest periods first while "
-                                            "they fit";
+      r.reason = "the critical set fails its EDF test: " + edf_failure_reason(cpu.edf);
     }
     (r.critical ? critical : others).push_back(std::move(r));
   }

@@ -100,6 +100,7 @@ GeneratedSet generate(Random& random, int index) {
     const int n = 2 + random.below(4);               // 2 to 5 tasks on this CPU
     const double total = 0.8 + 0.4 * random.unit();  // U from 0.8 to 1.2
     std::vector<double> weights;
+    weights.reserve(static_cast<std::size_t>(n));
     for (int i = 0; i < n; ++i) weights.push_back(0.2 + random.unit());
     const double sum = std::accumulate(weights.begin(), weights.end(), 0.0);
     for (int i = 0; i < n; ++i) {
@@ -173,6 +174,7 @@ void check_agreement(const std::string& yaml, std::int64_t for_ns, Outcome& outc
   const auto models = analysis::task_models(*spec, config->tasks, nullptr, &measured);
   const auto file_cpu = analysis::assign_subsystem_cpus(*spec, cpus);
   std::vector<int> cpu_of;
+  cpu_of.reserve(models.size());
   for (const auto& m : models) cpu_of.push_back(file_cpu[static_cast<std::size_t>(m.file_index)]);
   const auto result = analysis::analyse_configuration(models, cpu_of, cpus, SchedulerKind::kMuf);
 
