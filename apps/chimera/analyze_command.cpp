@@ -34,11 +34,31 @@ namespace {
 using analysis::TaskModel;
 using analysis::WcetProfile;
 
-// Whether analysis needs a C that neither the file nor the profile gives.
+// Whether analysis needs a C that neither the file nor the profile gives. A task whose C would
+// be its virtual_exec: is run too: on the virtual clock its module may charge more time.
 bool needs_measuring(const std::vector<TaskModel>& models) {
   return std::any_of(models.begin(), models.end(), [](const TaskModel& m) {
-    return !analysis::is_background(m) && m.wcet_source == analysis::WcetSource::kUnknown;
+    return !analysis::is_background(m) &&
+           (m.wcet_source == analysis::WcetSource::kUnknown || m.wcet_source == analysis::WcetSource::kVirtual);
   });
+}
+
+// The line that says how the measured C were found: simulated time where a task has some, the
+// host's time x the margin for the others.
+std::string measured_note(const WcetProfile& measured, std::int64_t length) {
+  const auto simulated = std::count_if(measured.tasks.begin(), measured.tasks.end(),
+                                       [](const analysis::ProfileEntry& e) { return e.simulated; });
+  const auto runs = fmt::format("the least of {} runs of {} on the virtual clock", kMeasureRuns, format_period(length));
+  if (simulated == 0)
+    return fmt::format("measured: C = {} x the longest cycle, {} (chimera profile and --wcet-from give better figures)",
+                       analysis::kMeasuredMargin, runs);
+  if (static_cast<std::size_t>(simulated) == measured.tasks.size())
+    return fmt::format(
+        "measured: C = the longest cycle's simulated time (virtual_exec plus what the module charged), {}", runs);
+  return fmt::format(
+      "measured: C = the longest cycle's simulated time (virtual_exec plus what the module charged) where a task has "
+      "one, else {} x its longest cycle on the host, {}",
+      analysis::kMeasuredMargin, runs);
 }
 
 // Prints the violations of the configurations to analyse; true when there are none.
@@ -65,17 +85,16 @@ std::optional<analysis::AnalysedConfiguration> analyse_one(const SubsystemSpec& 
   std::string note;
   if (needs_measuring(analysis::task_models(spec, config.tasks, profile))) {
     const std::int64_t length = measurement_length_ns(spec, config.name);
-    auto run = measure_profile(spec, config.name, ClockKind::kVirtual, length, kMeasureRuns, analysis::kMeasuredMargin);
+    // Simulated time is what the virtual clock will charge, exactly: no margin on it.
+    auto run =
+        measure_profile(spec, config.name, ClockKind::kVirtual, length, kMeasureRuns, analysis::kMeasuredMargin, 1.0);
     if (!run) {
       fmt::print(stderr, "{}: configuration '{}': cannot run it to measure execution times: {}\n", spec.file,
                  config.name, run.error().message);
       return std::nullopt;
     }
     measured = *std::move(run);
-    note = fmt::format(
-        "measured: C = {} x the longest cycle, the least of {} runs of {} on the virtual clock "
-        "(chimera profile and --wcet-from give better figures)",
-        analysis::kMeasuredMargin, kMeasureRuns, format_period(length));
+    note = measured_note(*measured, length);
   }
   const auto models = analysis::task_models(spec, config.tasks, profile, measured ? &*measured : nullptr, &order);
   std::vector<int> cpu_of;

@@ -22,12 +22,16 @@ inline constexpr int kMeasureRuns = 5;
 
 /// Runs `configuration` of `spec` `runs` times for `for_ns` on `clock` (its own shared memory,
 /// beside any running instance) and returns, per task that ran a cycle, the least over the runs
-/// of its longest cycle, x `margin`, as the budget (analysis::measured_entry()). On the virtual
+/// of its longest cycle, x a margin, as the budget (analysis::measured_entry()). The cycle's time
+/// is, on the virtual clock, the simulated time (virtual_exec plus what the module charged, the
+/// time the virtual clock's schedule is made of; x `simulated_margin`, entry.simulated) for a
+/// task that has some, else (and on the real clock) the host's (x `margin`). On the virtual
 /// clock every run takes the same inputs down the same paths, so a task's slowest cycle is there
 /// in each run, while the machine's stalls (another process taking the CPU mid-cycle) are not
 /// C and rarely strike every run. A task that fails while measured is reported as a warning;
 /// its cycles still count. Not real-time safe.
 Result<analysis::WcetProfile> measure_profile(const SubsystemSpec& spec, const std::string& configuration,
-                                              ClockKind clock, std::int64_t for_ns, int runs, double margin);
+                                              ClockKind clock, std::int64_t for_ns, int runs, double margin,
+                                              double simulated_margin);
 
 }  // namespace chimera::cli

@@ -51,7 +51,8 @@ int profile_command(const ProfileArgs& args) {
   const ClockKind clock = args.clock == "virtual" ? ClockKind::kVirtual : ClockKind::kReal;
   // One run: on the real clock every cycle's CPU time is measured (the thread's own clock, not
   // the wall clock, so preemption by other tasks is not counted as its execution).
-  auto profile = measure_profile(*spec, configuration, clock, args.for_ns, 1, args.margin);
+  // On the virtual clock a task's cycle time is its simulated time where it has some.
+  auto profile = measure_profile(*spec, configuration, clock, args.for_ns, 1, args.margin, args.margin);
   if (!profile) {
     fmt::print(stderr, "{}\n", profile.error().message);
     return kExitInvalid;
@@ -62,10 +63,16 @@ int profile_command(const ProfileArgs& args) {
   }
   fmt::print("{}: configuration '{}' ran {} on the {} clock; budgets = longest cycle x {}:\n", args.file, configuration,
              format_duration(args.for_ns), args.clock, args.margin);
-  for (const auto& e : profile->tasks)
-    fmt::print("  {:<16} wcet {:>10}  (longest {}, p99 {}, {} cycles)\n", e.task, format_duration(e.wcet_ns),
-               format_duration(e.exec_max_ns.value_or(0)), format_duration(e.exec_p99_ns.value_or(0)),
-               e.cycles.value_or(0));
+  for (const auto& e : profile->tasks) {
+    // Which clock the cycle times are in: on the virtual clock a task with no simulated time
+    // (no virtual_exec:, its module charges none) is timed on the host.
+    const char* in = clock == ClockKind::kReal ? ""
+                     : e.simulated             ? ", simulated time"
+                                               : ", host time: no simulated time";
+    fmt::print("  {:<16} wcet {:>10}  (longest {}, p99 {}, {} cycles{})\n", e.task, format_duration(e.wcet_ns),
+               format_duration(e.exec_max_ns.value_or(0)),
+               e.exec_p99_ns ? format_duration(*e.exec_p99_ns) : std::string("-"), e.cycles.value_or(0), in);
+  }
   fmt::print("written to {} (chimera analyze {} --wcet-from {})\n", args.output, args.file, args.output);
   return kExitOk;
 }

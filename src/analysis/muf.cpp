@@ -27,20 +27,28 @@ CriticalSet muf_critical_set(std::span<const TaskModel> cpu_tasks, const Analysi
   const auto order = muf_admission_order(cpu_tasks);
   std::vector<Demand> admitted;
 
-  // Hard tasks first: each must fit with those before it.
+  // Hard tasks first: each must fit with those before it; one that does not is left out, and the
+  // later ones are judged against the set that still holds.
   for (const std::size_t i : order) {
     if (!cpu_tasks[i].hard) continue;
-    set.critical[i] = true;
     const auto demand = demand_of(cpu_tasks[i], options);
-    if (demand) {
-      admitted.push_back(*demand);
-      if (edf_test(admitted).outcome == EdfOutcome::kFeasible) continue;
-      admitted.pop_back();  // judge the later hard tasks against a set that still holds
+    if (!demand) {
+      set.critical[i] = true;  // hard and unchecked: nothing says it does not fit
+      set.unknown_hard.push_back(i);
+      continue;
     }
+    admitted.push_back(*demand);
+    if (edf_test(admitted).outcome == EdfOutcome::kFeasible) {
+      set.critical[i] = true;
+      continue;
+    }
+    admitted.pop_back();
     set.unfit_hard.push_back(i);
   }
-  set.feasible = set.unfit_hard.empty();
-  if (!set.feasible) return set;  // nothing more can be guaranteed on a CPU whose hard tasks do not fit
+  set.feasible = set.unfit_hard.empty() && set.unknown_hard.empty();
+  // A soft task admitted now would outrank a hard one left out, or take time a hard one of
+  // unknown C may need: none is.
+  if (!set.feasible) return set;
 
   // Then the others, shortest period first, while the load stays feasible.
   for (const std::size_t i : order) {
@@ -52,6 +60,13 @@ CriticalSet muf_critical_set(std::span<const TaskModel> cpu_tasks, const Analysi
     set.critical[i] = true;
   }
   return set;
+}
+
+CriticalSet runtime_critical_set(std::span<const TaskModel> cpu_tasks) {
+  std::vector<TaskModel> known;
+  known.reserve(cpu_tasks.size());
+  for (const TaskModel& t : cpu_tasks) known.push_back(as_the_run_knows(t));
+  return muf_critical_set(known, AnalysisOptions{});
 }
 
 }  // namespace chimera::analysis

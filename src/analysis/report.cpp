@@ -47,13 +47,17 @@ std::string test_line(const CpuResult& cpu, std::span<const TaskModel> tasks) {
       if (!cpu.utilisation_complete) return utilisation_text(cpu) + ", bound 1; some C unknown: EDF cannot decide";
       return fmt::format("{}, bound 1 (EDF); {}", utilisation_text(cpu), edf_test_text(cpu.edf));
     case CpuTest::kMufCriticalSet: {
+      // The set the run orders jobs by, whether or not it passes the test with analysis' C.
       std::vector<std::string> critical;
       for (const auto& r : cpu.tasks)
-        if (r.critical && r.verdict == Verdict::kMeets) critical.push_back(tasks[r.index].name);
+        if (r.critical) critical.push_back(tasks[r.index].name);
       const std::string set =
           critical.empty() ? "critical set empty" : fmt::format("critical set {}", fmt::join(critical, ", "));
+      const char* outcome = cpu.feasible        ? "every hard task fits"
+                            : cpu.hard_left_out ? "a hard task does not fit"
+                                                : "the critical set is not guaranteed";
       return fmt::format("{}; {}: U = {:.3f}, bound 1 (EDF among critical tasks); {}", utilisation_text(cpu), set,
-                         cpu.edf.utilisation, cpu.feasible ? "every hard task fits" : "a hard task does not fit");
+                         cpu.edf.utilisation, outcome);
     }
   }
   return {};

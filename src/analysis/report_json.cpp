@@ -60,7 +60,9 @@ std::string_view outcome_of(const CpuResult& cpu) {
       // Some C unknown: the text says EDF cannot decide, and edf holds the test of the rest only.
       if (!cpu.utilisation_complete) return "execution_time_unknown";
       return edf_outcome_name(cpu.edf.outcome);
-    case CpuTest::kMufCriticalSet: return cpu.feasible ? "every_hard_task_fits" : "a_hard_task_does_not_fit";
+    case CpuTest::kMufCriticalSet:
+      if (cpu.feasible) return "every_hard_task_fits";
+      return cpu.hard_left_out ? "a_hard_task_does_not_fit" : "critical_set_not_guaranteed";
   }
   return "?";
 }
@@ -124,13 +126,16 @@ Json cpu_json(const CpuResult& cpu, std::span<const TaskModel> tasks) {
            {"feasible", cpu.feasible}};
   if (cpu.test != CpuTest::kNone && cpu.test != CpuTest::kResponseTime) out["edf"] = edf_json(cpu.edf);
   if (muf) {
-    // The set the text's heading names: the critical tasks that fit, in admission order. A hard
-    // task that does not fit is listed apart, as the reason the CPU is infeasible.
+    // The set the text's heading names, the one the run uses, in admission order. A hard task
+    // outside it (it does not fit) is listed apart, as the reason the CPU is infeasible.
     Json critical = Json::array();
     Json unfit = Json::array();
     for (const auto& r : cpu.tasks) {
-      if (!r.critical) continue;
-      (r.verdict == Verdict::kMeets ? critical : unfit).push_back(tasks[r.index].name);
+      const TaskModel& t = tasks[r.index];
+      if (r.critical)
+        critical.push_back(t.name);
+      else if (t.hard && !is_background(t))
+        unfit.push_back(t.name);
     }
     out["critical_set"] = std::move(critical);
     out["unfit_hard"] = std::move(unfit);

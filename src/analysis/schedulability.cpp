@@ -163,57 +163,86 @@ void analyse_edf(std::span<const TaskModel> tasks, const std::vector<std::option
 
 // MUF's critical set is chosen from C, T and D alone, as the runtime chooses it (it knows no
 // jitter); waits for producers on other CPUs are then checked against the set that holds.
-CriticalSet critical_set_without_jitter(std::span<const TaskModel> tasks, const AnalysisOptions& options) {
+CriticalSet critical_set_without_jitter(std::span<const TaskModel> tasks, bool from_a_file,
+                                        const AnalysisOptions& options) {
   std::vector<TaskModel> plain(tasks.begin(), tasks.end());
   for (auto& t : plain) t.release_jitter_ns = 0;
-  return muf_critical_set(plain, options);
+  return from_a_file ? runtime_critical_set(plain) : muf_critical_set(plain, options);
+}
+
+// Why a soft task is outside MUF's critical set.
+std::string outside_reason(const CriticalSet& set, const TaskModel& t) {
+  if (!set.unfit_hard.empty()) return "outside the critical set: a hard task does not fit, so no soft task is admitted";
+  if (!set.unknown_hard.empty())
+    return "outside the critical set: a hard task's execution time is not known before the run (give it a wcet), so "
+           "no soft task is admitted";
+  if (run_known_wcet(t) <= 0)
+    return "outside the critical set: its execution time is not known before the run (give the task a wcet)";
+  return "outside the critical set, which admits the shortest periods first while they fit";
+}
+
+// Why a hard task is outside MUF's critical set: with the C the run knows it does not fit.
+std::string left_out_reason(const std::vector<Demand>& critical_demands, const std::optional<Demand>& demand) {
+  if (demand) {
+    std::vector<Demand> with = critical_demands;
+    with.push_back(*demand);
+    const std::string why = edf_failure_reason(edf_test(with));
+    if (!why.empty()) return "hard, but does not fit in the critical set: with it, " + why;
+  }
+  return fmt::format(
+      "hard, but does not fit in the critical set with the C a run knows (wcet: or virtual_exec:, {} "
+      "of overhead)",
+      exact_duration_text(kDefaultOverheadNs));
 }
 
 void analyse_muf(std::span<const TaskModel> tasks, const std::vector<std::optional<Demand>>& demands,
                  const AnalysisOptions& options, CpuResult& cpu) {
-  const CriticalSet set = critical_set_without_jitter(tasks, options);
-  const auto unfit = [&](std::size_t i) {
-    return std::find(set.unfit_hard.begin(), set.unfit_hard.end(), i) != set.unfit_hard.end();
-  };
+  // The critical set is the one the run builds, from the C it knows before it starts (wcet:,
+  // virtual_exec:) and its overhead; analysis then checks that set with its own C (the profile's,
+  // a measurement), so that the set it names is the one the executive orders jobs by
+  // (analysis/muf.hpp). Models made by hand, which no run shares, are admitted as they are.
+  const bool from_a_file =
+      std::any_of(tasks.begin(), tasks.end(), [](const TaskModel& t) { return t.run_wcet_ns.has_value(); });
+  const CriticalSet set = critical_set_without_jitter(tasks, from_a_file, options);
   const auto order = muf_admission_order(tasks);
-  std::vector<Demand> fitting;
-  for (const std::size_t i : order)
-    if (set.critical[i] && !unfit(i)) fitting.push_back(*demands[i]);
-  cpu.edf = edf_test(fitting);
-  if (cpu.edf.outcome == EdfOutcome::kFeasible) cpu.busy_period_ns = longest_busy_period(fitting).value_or(0);
+  std::vector<Demand> critical_demands;
+  std::string unknown;  // a critical task whose C analysis does not know either
+  for (const std::size_t i : order) {
+    if (set.critical[i] && demands[i]) critical_demands.push_back(*demands[i]);
+    if (set.critical[i] && !demands[i] && unknown.empty()) unknown = tasks[i].name;
+  }
+  cpu.edf = edf_test(critical_demands);
+  const bool holds = unknown.empty() && cpu.edf.outcome == EdfOutcome::kFeasible;
+  if (holds) cpu.busy_period_ns = longest_busy_period(critical_demands).value_or(0);
 
   std::vector<TaskResult> critical;
   std::vector<TaskResult> others;
   for (const std::size_t i : order) {
+    const TaskModel& t = tasks[i];
     TaskResult r;
     r.index = i;
     r.demand = demands[i];
     r.critical = set.critical[i];
-    if (r.critical && !unfit(i) && cpu.edf.outcome != EdfOutcome::kFeasible) {
-      r.reason = "critical, but with the waits for producers on other CPUs, " + edf_failure_reason(cpu.edf);
-    } else if (r.critical && !unfit(i)) {
+    if (!r.critical) {
+      cpu.hard_left_out = cpu.hard_left_out || t.hard;
+      if (!t.hard) r.verdict = Verdict::kNoGuarantee;
+      r.reason = t.hard ? left_out_reason(critical_demands, r.demand) : outside_reason(set, t);
+    } else if (!r.demand) {
+      r.reason = (t.hard ? "hard, " : "") + unknown_reason(t);
+    } else if (!unknown.empty()) {
+      r.reason = fmt::format("cannot be bounded: {} in the critical set has an unknown execution time", unknown);
+    } else if (holds) {
       r.verdict = Verdict::kMeets;
       r.response_ns = r.demand->d_ns;
       r.response_is_bound = true;
-    } else if (r.critical) {
-      if (!r.demand) {
-        r.reason = "hard, " + unknown_reason(tasks[i]);
-      } else {
-        std::vector<Demand> with = fitting;
-        with.push_back(*r.demand);
-        r.reason = "hard, but does not fit in the critical set: with it, " + edf_failure_reason(edf_test(with));
-      }
     } else {
-      r.verdict = Verdict::kNoGuarantee;
-      r.reason = !set.feasible ? "outside the critical set: the hard tasks already do not fit"
-                 : !r.demand   ? "outside the critical set: " + unknown_reason(tasks[i])
-                               : "outside the critical set, which admits the shortest periods first while they fit";
+      r.reason = "the critical set fails its EDF test: " + edf_failure_reason(cpu.edf);
     }
     (r.critical ? critical : others).push_back(std::move(r));
   }
   for (auto& r : critical) cpu.tasks.push_back(std::move(r));
   for (auto& r : others) cpu.tasks.push_back(std::move(r));
-  cpu.feasible = set.feasible && cpu.edf.outcome == EdfOutcome::kFeasible;
+  cpu.feasible = holds && !cpu.hard_left_out;
 }
 
 }  // namespace

@@ -13,7 +13,11 @@ std::pair<std::int64_t, WcetSource> execution_time(const TaskSpec& t, const Wcet
   if (profile != nullptr)
     if (const ProfileEntry* e = profile->find(t.name)) return {e->wcet_ns, WcetSource::kProfile};
   if (measured != nullptr)
-    if (const ProfileEntry* e = measured->find(t.name)) return {e->wcet_ns, WcetSource::kMeasured};
+    if (const ProfileEntry* e = measured->find(t.name)) {
+      if (!e->simulated) return {e->wcet_ns, WcetSource::kMeasured};
+      // Simulated time: exactly the file's virtual_exec when the module charged nothing more.
+      return {e->wcet_ns, e->wcet_ns == t.virtual_exec_ns ? WcetSource::kVirtual : WcetSource::kSimulated};
+    }
   if (t.virtual_exec_ns > 0) return {t.virtual_exec_ns, WcetSource::kVirtual};  // a simulated cost, last
   return {0, WcetSource::kUnknown};
 }
@@ -41,6 +45,7 @@ std::vector<TaskModel> task_models(const SubsystemSpec& spec, std::span<const st
     m.user_priority = t.priority;
     m.cpu = t.cpu.value_or(-1);
     m.file_index = static_cast<int>(i);
+    m.run_wcet_ns = t.wcet_ns ? *t.wcet_ns : t.virtual_exec_ns;
     if (t.server) {
       // A served aperiodic task: its budget every server period, plus the one job that may run
       // over it (docs/scheduling.md); the C found above is that longest job.

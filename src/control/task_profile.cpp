@@ -54,8 +54,12 @@ std::string task_profile(const TaskSnapshot& t) {
   out += fmt::format("  cycles {}, missed {}, overruns {}, skipped {}, order timeouts {}\n", s.cycles, s.missed,
                      s.overruns, s.skipped, s.order_timeouts);
   if (s.cycles != 0) {
-    out += fmt::format("  exec     mean {}, p50 {}, p99 {}, max {}\n", format_duration(s.exec_mean_ns),
-                       format_duration(s.exec_p50_ns), format_duration(s.exec_p99_ns), format_duration(s.exec_max_ns));
+    out += fmt::format("  exec     mean {}, p50 {}, p99 {}, max {}{}\n", format_duration(s.exec_mean_ns),
+                       format_duration(s.exec_p50_ns), format_duration(s.exec_p99_ns), format_duration(s.exec_max_ns),
+                       s.exec_simulated ? " (simulated time)" : "");
+    if (s.exec_simulated)
+      out += fmt::format("  host     mean {}, max {} (what the cycles took on the host)\n",
+                         format_duration(s.host_exec_mean_ns), format_duration(s.host_exec_max_ns));
     out += fmt::format("  latency  p50 {}, p99 {}, max {}\n", format_duration(s.latency_p50_ns),
                        format_duration(s.latency_p99_ns), format_duration(s.latency_max_ns));
     out += fmt::format("  response p99 {}, max {}\n", format_duration(s.response_p99_ns),

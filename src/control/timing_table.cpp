@@ -1,5 +1,7 @@
 #include "chimera/control/timing_table.hpp"
 
+#include <algorithm>
+
 #include <fmt/format.h>
 
 #include "chimera/core/duration_text.hpp"
@@ -60,8 +62,13 @@ std::string timing_table(std::span<const TaskSnapshot> tasks, bool rt_check) {
   if (overruns) columns.push_back({"overruns", Align::kRight});
   if (skipped) columns.push_back({"skipped", Align::kRight});
   if (rt_violations) columns.push_back({"rt violations", Align::kRight});
-  for (const char* header : {"exec mean", "exec max", "latency p50", "latency p99", "latency max"})
-    columns.push_back({header, Align::kRight});
+  // On the virtual clock execution times are simulated (virtual_exec plus what the module
+  // charged), and the heading says so: they are not what the cycles cost the host.
+  const bool simulated =
+      std::any_of(tasks.begin(), tasks.end(), [](const TaskSnapshot& t) { return t.stats.exec_simulated; });
+  columns.push_back({simulated ? "exec mean (simulated)" : "exec mean", Align::kRight});
+  columns.push_back({simulated ? "exec max (simulated)" : "exec max", Align::kRight});
+  for (const char* header : {"latency p50", "latency p99", "latency max"}) columns.push_back({header, Align::kRight});
   TextTable table(std::move(columns));
   for (const auto& t : tasks) {
     auto cells = identity_cells(t);

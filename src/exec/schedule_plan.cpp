@@ -45,7 +45,7 @@ SchedulePlan make_schedule_plan(const ResolvedSubsystem& subsystem, const analys
     std::vector<analysis::TaskModel> on_cpu;
     for (const auto& m : models)
       if (plan.cpu[static_cast<std::size_t>(m.file_index)] == cpu) on_cpu.push_back(m);
-    const analysis::CriticalSet set = analysis::muf_critical_set(on_cpu);
+    const analysis::CriticalSet set = analysis::runtime_critical_set(on_cpu);
     for (std::size_t j = 0; j < on_cpu.size(); ++j)
       plan.urgency[static_cast<std::size_t>(on_cpu[j].file_index)].critical = set.critical[j];
   }

@@ -82,6 +82,13 @@ void TaskStats::record_cycle(std::int64_t latency_ns, std::int64_t exec_ns, std:
   if (exec_ns > exec_max_ns_.load(std::memory_order_relaxed)) exec_max_ns_.store(exec_ns, std::memory_order_relaxed);
 }
 
+void TaskStats::record_host_exec(std::int64_t ns) noexcept {
+  exec_simulated_.store(true, std::memory_order_relaxed);  // read on its own, like every figure
+  bump(host_cycles_);
+  host_exec_sum_ns_.store(host_exec_sum_ns_.load(std::memory_order_relaxed) + ns, std::memory_order_relaxed);
+  if (ns > host_exec_max_ns_.load(std::memory_order_relaxed)) host_exec_max_ns_.store(ns, std::memory_order_relaxed);
+}
+
 void TaskStats::record_skipped(std::uint64_t n) noexcept {
   bump(skipped_, n);
   bump(missed_, n);
@@ -106,6 +113,16 @@ TaskStatsSnapshot TaskStats::snapshot() const {
   s.exec_p50_ns = exec_.percentile(0.50);
   s.exec_p99_ns = exec_.percentile(0.99);
   s.exec_max_ns = exec_max_ns_.load(std::memory_order_relaxed);
+  s.exec_simulated = exec_simulated_.load(std::memory_order_relaxed);
+  if (s.exec_simulated) {
+    const std::uint64_t host_cycles = host_cycles_.load(std::memory_order_relaxed);
+    const std::int64_t host_sum = host_exec_sum_ns_.load(std::memory_order_relaxed);
+    s.host_exec_mean_ns = host_cycles != 0 ? host_sum / static_cast<std::int64_t>(host_cycles) : 0;
+    s.host_exec_max_ns = host_exec_max_ns_.load(std::memory_order_relaxed);
+  } else {
+    s.host_exec_mean_ns = s.exec_mean_ns;
+    s.host_exec_max_ns = s.exec_max_ns;
+  }
   s.latency_p50_ns = latency_.percentile(0.50);
   s.latency_p99_ns = latency_.percentile(0.99);
   s.latency_max_ns = latency_.max();
@@ -130,6 +147,10 @@ void TaskStats::reset() noexcept {
   rt_allocations_.store(0, std::memory_order_relaxed);
   exec_sum_ns_.store(0, std::memory_order_relaxed);
   exec_max_ns_.store(0, std::memory_order_relaxed);
+  exec_simulated_.store(false, std::memory_order_relaxed);
+  host_cycles_.store(0, std::memory_order_relaxed);
+  host_exec_sum_ns_.store(0, std::memory_order_relaxed);
+  host_exec_max_ns_.store(0, std::memory_order_relaxed);
 }
 
 }  // namespace chimera

@@ -51,7 +51,7 @@ struct TaskResult {
   /// rm, dm: response_ns is the latest completion found before the analysis gave up, already
   /// past the deadline, so the true worst case is at least that (the reason says "at least").
   bool response_is_lower_bound = false;
-  bool critical = false;  // muf: in the critical set
+  bool critical = false;  // muf: in the critical set the run uses
   /// How long after its release the task may wait for its same-rate producers on other CPUs
   /// (analyse_configuration(); 0 on one CPU). Its response time includes the wait.
   std::int64_t release_jitter_ns = 0;
@@ -70,17 +70,23 @@ struct CpuResult {
   double ll_bound = 1;               // Liu and Layland for `periodic` tasks
   bool implicit_deadlines = true;    // every D == T (where the bound applies, under rm)
   CpuTest test = CpuTest::kNone;
-  /// edf: the test of all tasks; muf: of the critical set's tasks that fit.
+  /// edf: the test of all tasks; muf: of the critical set (the run's, analysis/muf.hpp) with
+  /// analysis' C; a critical task of unknown C is left out of it (and cannot be bounded).
   EdfTest edf;
   /// edf, muf: the longest busy period of those tasks (longest_busy_period()), 0 if none: a job
   /// that becomes ready ends within it, a tighter bound than D on how long a consumer on another
   /// CPU waits for it. (rm, dm have exact response times.)
   std::int64_t busy_period_ns = 0;
+  /// muf: a hard task is outside the critical set (it does not fit with the C a run knows).
+  bool hard_left_out = false;
   /// Every task meets its deadline, but for muf's non-critical tasks and background tasks.
   bool feasible = true;
 };
 
-/// Analyses the tasks of one CPU (their `cpu` field is not looked at). Not real-time safe.
+/// Analyses the tasks of one CPU (their `cpu` field is not looked at). Under muf the critical set
+/// is the run's (runtime_critical_set(): the C a run knows, its overhead) when the models come
+/// from a file (run_wcet_ns set), else muf_critical_set() with `options`; either way it is then
+/// checked with the models' C and `options`. Not real-time safe.
 [[nodiscard]] CpuResult analyse_cpu(std::span<const TaskModel> tasks, SchedulerKind scheduler,
                                     const AnalysisOptions& options = {});
 

@@ -12,11 +12,12 @@ namespace chimera::analysis {
 
 /// Where a task's execution time C came from.
 enum class WcetSource {
-  kUnknown,   // nowhere: analysis cannot bound the task
-  kFile,      // the subsystem file's `wcet:`
-  kProfile,   // a profile file (`chimera analyze --wcet-from`, written by `chimera profile`)
-  kMeasured,  // a short virtual-clock run by `chimera analyze`, with a safety margin
-  kVirtual,   // the file's `virtual_exec:`, the simulated cost (the virtual clock's own plan)
+  kUnknown,    // nowhere: analysis cannot bound the task
+  kFile,       // the subsystem file's `wcet:`
+  kProfile,    // a profile file (`chimera analyze --wcet-from`, written by `chimera profile`)
+  kMeasured,   // a short virtual-clock run by `chimera analyze`: host time, with a safety margin
+  kVirtual,    // the file's `virtual_exec:`, the simulated cost (the virtual clock's own plan)
+  kSimulated,  // a short virtual-clock run: the simulated time (virtual_exec plus what the module charged)
 };
 
 std::string_view wcet_source_name(WcetSource source);
@@ -53,7 +54,19 @@ struct TaskModel {
   /// Release jitter: how long after its release the task may wait for those producers when they
   /// run on another CPU. analyse_configuration() finds it from their response times.
   std::int64_t release_jitter_ns = 0;
+  /// The C a run knows before it starts (the file's `wcet:`, else its `virtual_exec:`; for a
+  /// server its longest job), 0: unknown; task_models() sets it. nullopt (a model made by hand):
+  /// the C above. The runtime builds MUF's critical set from it.
+  std::optional<std::int64_t> run_wcet_ns = std::nullopt;
 };
+
+/// The C (for a server its longest job) a run knows before it starts; 0: unknown.
+[[nodiscard]] inline std::int64_t run_known_wcet(const TaskModel& task) {
+  return task.run_wcet_ns.value_or(task.server ? task.job_wcet_ns : task.wcet_ns);
+}
+
+/// The task as a run sees it before it starts: its C (a server's longest job) is run_known_wcet().
+[[nodiscard]] TaskModel as_the_run_knows(const TaskModel& task);
 
 /// The framework's own cost of one cycle that the module's C does not contain (release, dispatch,
 /// the state-variable transfers and the statistics: docs/scheduling.md). 1 µs is the project's

@@ -29,6 +29,7 @@ struct ProfileEntry {
   std::optional<std::int64_t> exec_p99_ns;  // 99% of the cycles took at most this
   std::optional<std::uint64_t> cycles;      // how many cycles were seen
   int line = 0;                             // where the entry stands in the file read; 0: not read
+  bool simulated = false;                   // measured in simulated time (virtual clock), not host time
 };
 
 struct WcetProfile {

@@ -40,6 +40,9 @@ class LatencyHistogram {
 
 /// A copy of a task's figures, for the timing table and --stats-json.
 struct TaskStatsSnapshot {
+  /// Which clock the exec_* figures are in: false, the host's (real clock: the cycle's CPU or
+  /// wall time); true, simulated (virtual clock: virtual_exec plus what the module charged).
+  bool exec_simulated = false;
   std::uint64_t cycles = 0;
   std::uint64_t missed = 0;    // deadlines missed: cycles that ended late, plus skipped releases
   std::uint64_t overruns = 0;  // cycles that ran longer than the task's wcet budget
@@ -48,6 +51,10 @@ struct TaskStatsSnapshot {
   std::int64_t exec_p50_ns = 0;
   std::int64_t exec_p99_ns = 0;
   std::int64_t exec_max_ns = 0;
+  /// The host's time the cycles took: the exec_* figures' own on the real clock; on the virtual
+  /// clock what the framework and the module spent on the host while simulated time stood still.
+  std::int64_t host_exec_mean_ns = 0;
+  std::int64_t host_exec_max_ns = 0;
   std::int64_t latency_p50_ns = 0;  // release to start of cycle
   std::int64_t latency_p99_ns = 0;
   std::int64_t latency_max_ns = 0;
@@ -70,6 +77,9 @@ class TaskStats {
   /// One finished cycle: release to start, execution time, release to end. Real-time safe.
   void record_cycle(std::int64_t latency_ns, std::int64_t exec_ns, std::int64_t response_ns, bool missed,
                     bool overrun) noexcept;
+  /// The host's time of the cycle just recorded, when record_cycle() was given its simulated
+  /// time (virtual clock): from then on the snapshot's exec figures are simulated. Real-time safe.
+  void record_host_exec(std::int64_t ns) noexcept;
   /// `n` releases skipped without running (each a missed deadline). Real-time safe.
   void record_skipped(std::uint64_t n) noexcept;
   /// A precedence wait gave up. Real-time safe.
@@ -92,6 +102,10 @@ class TaskStats {
   std::atomic<std::uint64_t> rt_allocations_{0};
   std::atomic<std::int64_t> exec_sum_ns_{0};
   std::atomic<std::int64_t> exec_max_ns_{0};
+  std::atomic<bool> exec_simulated_{false};
+  std::atomic<std::uint64_t> host_cycles_{0};
+  std::atomic<std::int64_t> host_exec_sum_ns_{0};
+  std::atomic<std::int64_t> host_exec_max_ns_{0};
 };
 
 }  // namespace chimera

@@ -1,5 +1,5 @@
 // MUF's critical set (Stewart and Khosla 1991): hard tasks first, then the others by period while
-// the critical set stays feasible.
+// the critical set stays feasible; a hard task that does not fit is not critical.
 
 #include "chimera/analysis/muf.hpp"
 
@@ -38,14 +38,37 @@ TEST(MufCriticalSet, ASoftTaskThatDoesNotFitEndsTheSet) {
   EXPECT_EQ(set.critical, (std::vector<bool>{true, true, false, false}));
 }
 
-TEST(MufCriticalSet, AHardTaskThatDoesNotFitIsReported) {
-  // Hard (3, 5) then hard (3, 6): 1.1. The longer period is admitted second and does not fit;
-  // the soft task gets nothing.
+TEST(MufCriticalSet, AHardTaskThatDoesNotFitIsNotCritical) {
+  // Hard (3, 5) then hard (3, 6): 1.1. The longer period is admitted second, does not fit and is
+  // left out of the set, so that it cannot take the time of the one that fits (as the paper
+  // has it: a task outside the critical set is not critical); the soft task gets nothing.
   const std::vector<TaskModel> tasks{task("x", 3, 6, true, 0), task("y", 3, 5, true, 1), task("s", 1, 100, false, 2)};
   const auto set = muf_critical_set(tasks, kNoOverhead);
   EXPECT_FALSE(set.feasible);
   EXPECT_EQ(set.unfit_hard, (std::vector<std::size_t>{0}));
-  EXPECT_EQ(set.critical, (std::vector<bool>{true, true, false}));  // every hard task is critical
+  EXPECT_TRUE(set.unknown_hard.empty());
+  EXPECT_EQ(set.critical, (std::vector<bool>{false, true, false}));
+}
+
+TEST(MufCriticalSet, LaterHardTasksAreJudgedAgainstTheSetThatHolds) {
+  // y (3, 5) fits, x (3, 6) does not (1.1), z (2, 10) fits beside y alone (0.8): z is critical.
+  const std::vector<TaskModel> tasks{task("x", 3, 6, true, 0), task("y", 3, 5, true, 1), task("z", 2, 10, true, 2)};
+  const auto set = muf_critical_set(tasks, kNoOverhead);
+  EXPECT_FALSE(set.feasible);
+  EXPECT_EQ(set.unfit_hard, (std::vector<std::size_t>{0}));
+  EXPECT_EQ(set.critical, (std::vector<bool>{false, true, true}));
+}
+
+TEST(MufCriticalSet, NoSoftTaskIsAdmittedOnceAHardTaskDoesNotFit) {
+  // y (3, 5) is critical and x (3, 6) does not fit; soft s (1, 100) would fit beside y (0.61)
+  // but is not admitted: the rule is that x then competes with s by deadline, outside the set,
+  // instead of running below a soft task.
+  const std::vector<TaskModel> tasks{task("x", 3, 6, true, 0), task("y", 3, 5, true, 1), task("s", 1, 100, false, 2)};
+  const auto set = muf_critical_set(tasks, kNoOverhead);
+  EXPECT_FALSE(set.critical[2]);
+  // Without x, s is admitted: it is x, not the load, that keeps it out.
+  const std::vector<TaskModel> without_x{task("y", 3, 5, true, 0), task("s", 1, 100, false, 1)};
+  EXPECT_EQ(muf_critical_set(without_x, kNoOverhead).critical, (std::vector<bool>{true, true}));
 }
 
 TEST(MufCriticalSet, ConstrainedDeadlinesUseTheDemandTest) {
@@ -57,15 +80,39 @@ TEST(MufCriticalSet, ConstrainedDeadlinesUseTheDemandTest) {
 }
 
 TEST(MufCriticalSet, UnknownExecutionTimes) {
-  // A hard task of unknown C cannot be guaranteed; a soft one ends the critical set.
+  // A soft task of unknown C ends the critical set. A hard one is critical but unchecked: nothing
+  // is guaranteed by the set alone, and no soft task is admitted beside it.
   std::vector<TaskModel> tasks{task("a", 1, 4, true, 0), task("b", 0, 6, false, 1), task("c", 1, 8, false, 2)};
   auto set = muf_critical_set(tasks, kNoOverhead);
   EXPECT_TRUE(set.feasible);
   EXPECT_EQ(set.critical, (std::vector<bool>{true, false, false}));
   tasks[0].wcet_ns = 0;
+  tasks[1].wcet_ns = 1;
   set = muf_critical_set(tasks, kNoOverhead);
   EXPECT_FALSE(set.feasible);
-  EXPECT_EQ(set.unfit_hard, (std::vector<std::size_t>{0}));
+  EXPECT_TRUE(set.unfit_hard.empty());
+  EXPECT_EQ(set.unknown_hard, (std::vector<std::size_t>{0}));
+  EXPECT_EQ(set.critical, (std::vector<bool>{true, false, false}));
+}
+
+TEST(MufCriticalSet, TheRunsSetTakesTheCItKnowsBeforeItStarts) {
+  // a's file gives no C (run_wcet_ns 0) but a measurement does (wcet_ns 3): the run cannot
+  // check a, so a is critical unchecked and the soft b stays out; analysis checks that set.
+  std::vector<TaskModel> tasks{task("a", 3, 5, true, 0), task("b", 1, 10, false, 1)};
+  tasks[0].run_wcet_ns = 0;
+  tasks[1].run_wcet_ns = 1;
+  EXPECT_EQ(muf_critical_set(tasks, kNoOverhead).critical, (std::vector<bool>{true, true}));
+  auto run = runtime_critical_set(tasks);
+  EXPECT_EQ(run.critical, (std::vector<bool>{true, false}));
+  EXPECT_EQ(run.unknown_hard, (std::vector<std::size_t>{0}));
+  // With the C known to the run, and with its 1 µs overhead: (5, 10) twice is 100% without it.
+  constexpr std::int64_t kMs = 1'000'000;
+  tasks = {task("x", 5 * kMs, 10 * kMs, true, 0), task("y", 5 * kMs, 10 * kMs, true, 1)};
+  tasks[0].run_wcet_ns = tasks[1].run_wcet_ns = 5 * kMs;
+  EXPECT_TRUE(muf_critical_set(tasks, kNoOverhead).feasible);
+  run = runtime_critical_set(tasks);
+  EXPECT_EQ(run.critical, (std::vector<bool>{true, false}));
+  EXPECT_EQ(run.unfit_hard, (std::vector<std::size_t>{1}));
 }
 
 TEST(MufCriticalSet, TheOverheadCounts) {

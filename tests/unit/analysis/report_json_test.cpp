@@ -59,7 +59,7 @@ AnalysedConfiguration rm_configuration() {
   return c;
 }
 
-// One CPU under muf: a fits, h is hard and does not, s is outside the set.
+// One CPU under muf: a fits, h is hard and does not (so it is outside the set), s is outside it too.
 AnalysedConfiguration muf_configuration() {
   AnalysedConfiguration c;
   c.context = ReportContext{"f.yaml", "other", SchedulerKind::kMuf, AnalysisOptions{}, ""};
@@ -72,11 +72,11 @@ AnalysedConfiguration muf_configuration() {
   cpu.edf.utilisation = 0.5;
   cpu.edf.utilisation_decides = true;
   cpu.feasible = false;
+  cpu.hard_left_out = true;
   cpu.tasks.push_back(result(0, Verdict::kMeets, 4 * kMs));
   cpu.tasks.back().critical = true;
   cpu.tasks.back().response_is_bound = true;
-  cpu.tasks.push_back(result(1, Verdict::kCanMiss, 0, "hard, but does not fit"));
-  cpu.tasks.back().critical = true;
+  cpu.tasks.push_back(result(1, Verdict::kCanMiss, 0, "hard, but does not fit"));  // not critical: left out
   cpu.tasks.push_back(result(2, Verdict::kNoGuarantee, 0, "outside the critical set"));
   c.result.cpu_of = {0, 0, 0};
   c.result.cpus = {cpu};

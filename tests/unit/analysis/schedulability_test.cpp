@@ -149,8 +149,36 @@ TEST(AnalyseCpu, MufHardTaskThatDoesNotFit) {
   EXPECT_FALSE(cpu.feasible);
   EXPECT_EQ(result_of(cpu, 1).verdict, Verdict::kMeets);
   EXPECT_EQ(result_of(cpu, 0).verdict, Verdict::kCanMiss);
-  EXPECT_TRUE(result_of(cpu, 0).critical);
+  EXPECT_FALSE(result_of(cpu, 0).critical);  // left out, so that y keeps its guarantee
+  EXPECT_TRUE(cpu.hard_left_out);
   EXPECT_EQ(result_of(cpu, 0).reason, "hard, but does not fit in the critical set: with it, overloaded: U = 1.100 > 1");
+}
+
+TEST(AnalyseCpu, MufChecksTheRunsCriticalSetWithItsOwnC) {
+  // From a file: a's C is known to the run (wcet: 2 ms), b's only to analysis (3 ms measured), c
+  // is soft (1 ms of 10). The run admits a, then b unchecked, and so no soft task: c is outside.
+  constexpr std::int64_t kMs = 1'000'000;
+  std::vector<TaskModel> tasks{task("a", 2 * kMs, 5 * kMs, 0), task("b", 3 * kMs, 10 * kMs, 1),
+                               task("c", 1 * kMs, 10 * kMs, 2, 0, false)};
+  tasks[0].run_wcet_ns = 2 * kMs;
+  tasks[1].run_wcet_ns = 0;
+  tasks[2].run_wcet_ns = 1 * kMs;
+  auto cpu = analyse_cpu(tasks, SchedulerKind::kMuf, kNoOverhead);
+  EXPECT_TRUE(cpu.feasible);  // 0.4 + 0.3 with analysis' C
+  EXPECT_TRUE(result_of(cpu, 1).critical);
+  EXPECT_EQ(result_of(cpu, 1).verdict, Verdict::kMeets);
+  EXPECT_FALSE(result_of(cpu, 2).critical);
+  EXPECT_EQ(result_of(cpu, 2).reason,
+            "outside the critical set: a hard task's execution time is not known before the run (give it a wcet), so "
+            "no soft task is admitted");
+  // b turns out to take 7 ms: the set the run uses fails, and every critical task can miss.
+  tasks[1].wcet_ns = 7 * kMs;
+  cpu = analyse_cpu(tasks, SchedulerKind::kMuf, kNoOverhead);
+  EXPECT_FALSE(cpu.feasible);
+  EXPECT_FALSE(cpu.hard_left_out);
+  EXPECT_EQ(result_of(cpu, 0).verdict, Verdict::kCanMiss);
+  EXPECT_EQ(result_of(cpu, 0).reason, "the critical set fails its EDF test: overloaded: U = 1.100 > 1");
+  EXPECT_EQ(result_of(cpu, 1).verdict, Verdict::kCanMiss);
 }
 
 TEST(AnalyseCpu, UnknownExecutionTimes) {

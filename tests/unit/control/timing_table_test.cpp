@@ -83,6 +83,31 @@ TEST(TimingTable, HumanUnitsAndDashesForTasksThatNeverRan) {
   EXPECT_EQ(display_width(lines[0]), display_width(lines[1]));
 }
 
+TEST(TimingTable, SimulatedExecutionTimesSaySo) {
+  auto tasks = sample();
+  EXPECT_EQ(timing_table(tasks).find("(simulated)"), std::string::npos);
+  tasks[0].stats.exec_simulated = true;
+  const auto lines = lines_of(timing_table(tasks));
+  EXPECT_NE(lines[0].find("exec mean (simulated)"), std::string::npos) << lines[0];
+  EXPECT_NE(lines[0].find("exec max (simulated)"), std::string::npos) << lines[0];
+  EXPECT_EQ(display_width(lines[0]), display_width(lines[1]));
+}
+
+TEST(StatsJson, SaysWhichClockExecutionTimesAreIn) {
+  auto tasks = sample();
+  tasks[0].stats.host_exec_mean_ns = 900;
+  tasks[0].stats.host_exec_max_ns = 1200;
+  auto doc = nlohmann::json::parse(stats_json(tasks, ClockKind::kVirtual, 0));
+  EXPECT_EQ(doc.at("exec_clock"), "virtual");
+  EXPECT_EQ(doc.at("tasks").at("pid").at("exec_clock"), "virtual");
+  EXPECT_EQ(doc.at("tasks").at("pid").at("host_exec_ns").at("mean"), 900);
+  EXPECT_EQ(doc.at("tasks").at("pid").at("host_exec_ns").at("max"), 1200);
+  EXPECT_EQ(doc.at("tasks").at("pid").at("exec_ns").at("max"), 250'000);  // the existing key stays
+  doc = nlohmann::json::parse(stats_json(tasks, ClockKind::kReal, 0));
+  EXPECT_EQ(doc.at("exec_clock"), "host");
+  EXPECT_EQ(doc.at("tasks").at("traj").at("exec_clock"), "host");
+}
+
 TEST(TimingTable, RtViolationsColumnWithTheCheckOrWhenAnyTaskHasSome) {
   EXPECT_EQ(timing_table(sample()).find("rt violations"), std::string::npos);
   // With --rt-check, zeros are the answer: the column shows.

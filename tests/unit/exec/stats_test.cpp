@@ -28,6 +28,30 @@ TEST(LatencyHistogram, PercentilesOfAKnownDistribution) {
   EXPECT_EQ(h.percentile(0.5), 0);
 }
 
+TEST(TaskStats, OnTheVirtualClockExecutionTimesAreSimulatedAndTheHostsKeptApart) {
+  TaskStats s;
+  EXPECT_FALSE(s.snapshot().exec_simulated);
+  s.record_cycle(0, 2'000'000, 2'000'000, false, false);  // 2 ms simulated...
+  s.record_host_exec(1500);                               // ... that took the host 1.5 µs
+  s.record_cycle(0, 4'000'000, 4'000'000, false, false);
+  s.record_host_exec(2500);
+  auto snap = s.snapshot();
+  EXPECT_TRUE(snap.exec_simulated);
+  EXPECT_EQ(snap.exec_mean_ns, 3'000'000);
+  EXPECT_EQ(snap.exec_max_ns, 4'000'000);
+  EXPECT_EQ(snap.host_exec_mean_ns, 2000);
+  EXPECT_EQ(snap.host_exec_max_ns, 2500);
+  s.reset();
+  EXPECT_FALSE(s.snapshot().exec_simulated);
+  EXPECT_EQ(s.snapshot().host_exec_max_ns, 0);
+  // On the real clock the host's figures are the execution times themselves.
+  s.record_cycle(0, 700, 900, false, false);
+  snap = s.snapshot();
+  EXPECT_FALSE(snap.exec_simulated);
+  EXPECT_EQ(snap.host_exec_mean_ns, 700);
+  EXPECT_EQ(snap.host_exec_max_ns, 700);
+}
+
 TEST(TaskStats, CountsCyclesMissesAndExecutionTimes) {
   TaskStats s;
   s.record_cycle(100, 1000, 1100, false, false);
