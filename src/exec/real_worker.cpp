@@ -282,10 +282,6 @@ void Worker::wait_for_predecessors(std::int64_t release, std::int64_t release_ab
   const std::int64_t now = monotonic_ns();
   const std::int64_t spin_until = now - release_abs >= task->period_ns() ? now + kCatchUpSpinNs : 0;
   for (Worker* p : predecessors) {
-    // A producer on this thread has had its turn in this pass (it comes first in data-flow
-    // order); if it has not run the release, it is behind and can only catch up once we return:
-    // waiting for it would be waiting for ourselves, until the bound, at every release.
-    if (p->thread == thread) continue;
     for (;;) {
       // acquire: its cycle's outputs are published
       const std::uint32_t done = p->precedence.completed.load(std::memory_order_acquire);
@@ -297,6 +293,15 @@ void Worker::wait_for_predecessors(std::int64_t release, std::int64_t release_ab
       const bool on = joining || p->task->state() == TaskState::kOn;
       // acquire: pairs with its store of the release it is about to run
       const std::int64_t next = joining ? joins : p->precedence.scheduled.load(std::memory_order_acquire);
+      if (p->thread == thread) {
+        // A producer on this thread has had its turn in this pass (it comes first in data-flow
+        // order); if it has not run the release it is behind, and can only catch up once we
+        // return: waiting would be waiting for ourselves, until the bound. Counted like a wait
+        // that gave up, since this release runs without its value.
+        behind = behind || release_policy::waits_for_producer(on, completed, completed_previous, next, release) ||
+                 release_policy::producer_behind(on, completed, completed_previous, next, release);
+        break;
+      }
       if (!release_policy::waits_for_producer(on, completed, completed_previous, next, release)) {
         behind = behind || release_policy::producer_behind(on, completed, completed_previous, next, release);
         break;

@@ -57,10 +57,14 @@ void TaskThread::run_periodic_members() {
     // producer's value of the same release. A member that does not move on (off, held, left) ends
     // its turn, and so does one that has run kCatchUpPerPass releases: a task whose cycles outlast
     // its period never catches up, and the mail (signals, switches) must still be read.
+    // One instant for the whole pass: a release that comes due while the pass runs waits for the
+    // next pass for every member alike, or a consumer could run a release its producer, earlier in
+    // the pass, had not yet found due.
     constexpr int kCatchUpPerPass = 256;
+    const std::int64_t now = monotonic_ns();
     for (Worker* m : members) {
       std::int64_t k = -1;
-      for (int n = 0; n < kCatchUpPerPass && m->schedule.k != k && m->prepare() <= monotonic_ns(); ++n) {
+      for (int n = 0; n < kCatchUpPerPass && m->schedule.k != k && m->prepare() <= now; ++n) {
         k = m->schedule.k;
         m->act();
       }

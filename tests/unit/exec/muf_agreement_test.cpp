@@ -17,13 +17,13 @@
 #include <gtest/gtest.h>
 
 #include "chimera/analysis/cpu_assignment.hpp"
+#include "chimera/analysis/release_order.hpp"
 #include "chimera/analysis/schedulability.hpp"
 #include "chimera/analysis/task_models.hpp"
 #include "chimera/analysis/wcet_profile.hpp"
 #include "chimera/config/loader.hpp"
 #include "chimera/config/verify.hpp"
 #include "chimera/control/subsystem.hpp"
-#include "exec/release_order.hpp"
 #include "exec/schedule_plan.hpp"
 #include "support/run_subsystem.hpp"
 #include "support/trace_module.hpp"
@@ -154,8 +154,8 @@ void check_agreement(const std::string& yaml, std::int64_t for_ns, Outcome& outc
   // The runtime's plan: what both executives order jobs by (and the CPU each task runs on).
   const Resolution resolution = resolve_subsystem(*spec, registry);
   const std::vector<int> cpus = subsystem_cpus(*spec);
-  const SchedulePlan plan =
-      make_schedule_plan(resolution.subsystem, compute_release_order(resolution.subsystem), cpus, config->tasks);
+  const analysis::ReleaseOrder order = analysis::compute_release_order(resolution.subsystem);
+  const SchedulePlan plan = make_schedule_plan(resolution.subsystem, order, cpus, config->tasks);
 
   auto run = testing::start_subsystem(yaml, registry);
   ASSERT_TRUE(run);
@@ -171,8 +171,8 @@ void check_agreement(const std::string& yaml, std::int64_t for_ns, Outcome& outc
     entry.simulated = true;
     measured.tasks.push_back(std::move(entry));
   }
-  const auto models = analysis::task_models(*spec, config->tasks, nullptr, &measured);
-  const auto file_cpu = analysis::assign_subsystem_cpus(*spec, cpus);
+  const auto models = analysis::task_models(*spec, config->tasks, nullptr, &measured, &order);
+  const auto file_cpu = analysis::assign_subsystem_cpus(*spec, order, cpus);
   std::vector<int> cpu_of;
   cpu_of.reserve(models.size());
   for (const auto& m : models) cpu_of.push_back(file_cpu[static_cast<std::size_t>(m.file_index)]);
