@@ -5,12 +5,13 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cerrno>
 #include <cstdlib>
-#include <cstring>
 #include <fstream>
 #include <sstream>
+#include <system_error>
 
 #include <fmt/format.h>
 
@@ -20,13 +21,16 @@ namespace {
 
 constexpr std::size_t kRandomBytes = 32;
 
+// strerror() is not thread-safe; the error_code's message is.
+std::string errno_text(int error) { return std::error_code(error, std::generic_category()).message(); }
+
 Result<std::string> random_hex() {
   std::array<unsigned char, kRandomBytes> bytes{};
   std::size_t got = 0;
   while (got < bytes.size()) {
     const ssize_t n = ::getrandom(bytes.data() + got, bytes.size() - got, 0);
     if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return make_error(Errc::kSystem, fmt::format("getrandom: {}", std::strerror(errno)));
+    if (n <= 0) return make_error(Errc::kSystem, fmt::format("getrandom: {}", errno_text(errno)));
     got += static_cast<std::size_t>(n);
   }
   std::string hex;
@@ -35,9 +39,7 @@ Result<std::string> random_hex() {
 }
 
 bool visible_ascii(std::string_view token) {
-  for (char c : token)
-    if (c < '!' || c > '~') return false;
-  return true;
+  return std::ranges::all_of(token, [](char c) { return c >= '!' && c <= '~'; });
 }
 
 std::vector<std::string_view> words_of(std::string_view line) {
@@ -62,7 +64,7 @@ bool same_token(std::string_view a, std::string_view b) {
 
 Result<void> private_directory(const std::string& dir) {
   if (::mkdir(dir.c_str(), 0700) != 0 && errno != EEXIST)
-    return make_error(Errc::kSystem, fmt::format("cannot create {}: {}", dir, std::strerror(errno)));
+    return make_error(Errc::kSystem, fmt::format("cannot create {}: {}", dir, errno_text(errno)));
   struct stat st {};
   if (::lstat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode))
     return make_error(Errc::kSystem, fmt::format("{} is not a directory", dir));
@@ -89,7 +91,7 @@ Result<AccessTokens> AccessTokens::generate() {
 Result<AccessTokens> AccessTokens::load(const std::string& path) {
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0)
-    return make_error(Errc::kInvalidInput, fmt::format("--token-file {}: {}", path, std::strerror(errno)));
+    return make_error(Errc::kInvalidInput, fmt::format("--token-file {}: {}", path, errno_text(errno)));
   if ((st.st_mode & 077) != 0)
     return make_error(Errc::kInvalidInput,
                       fmt::format("--token-file {}: other users may read it (mode {:04o}); chmod 600 {}", path,
@@ -156,9 +158,10 @@ std::string AccessTokens::file_text() const {
 Result<void> write_private_file(const std::string& path, std::string_view text) {
   // A fresh file, so that its mode is ours from the first byte; never through a link left there.
   if (::unlink(path.c_str()) != 0 && errno != ENOENT)
-    return make_error(Errc::kSystem, fmt::format("cannot replace {}: {}", path, std::strerror(errno)));
+    return make_error(Errc::kSystem, fmt::format("cannot replace {}: {}", path, errno_text(errno)));
+  // NOLINTNEXTLINE(cppcoreguidelines-pro-type-vararg): open() takes the mode as its vararg; no other call sets it
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC | O_NOFOLLOW, 0600);
-  if (fd < 0) return make_error(Errc::kSystem, fmt::format("cannot write {}: {}", path, std::strerror(errno)));
+  if (fd < 0) return make_error(Errc::kSystem, fmt::format("cannot write {}: {}", path, errno_text(errno)));
   std::size_t done = 0;
   while (done < text.size()) {
     const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
@@ -166,12 +169,11 @@ Result<void> write_private_file(const std::string& path, std::string_view text) 
     if (n <= 0) {
       const int error = errno;
       ::close(fd);
-      return make_error(Errc::kSystem, fmt::format("cannot write {}: {}", path, std::strerror(error)));
+      return make_error(Errc::kSystem, fmt::format("cannot write {}: {}", path, errno_text(error)));
     }
     done += static_cast<std::size_t>(n);
   }
-  if (::close(fd) != 0)
-    return make_error(Errc::kSystem, fmt::format("cannot write {}: {}", path, std::strerror(errno)));
+  if (::close(fd) != 0) return make_error(Errc::kSystem, fmt::format("cannot write {}: {}", path, errno_text(errno)));
   return {};
 }
 

@@ -165,8 +165,12 @@ ApiResponse ControlApi::too_large() {
 
 void ControlApi::close() { closing_ = true; }
 
+std::optional<Role> ControlApi::role_of(std::string_view authorization) const {
+  return tokens_.role_of(bearer_token(authorization));
+}
+
 ApiResponse ControlApi::handle(const ApiRequest& request) {
-  const std::optional<Role> role = tokens_.role_of(bearer_token(request.authorization));
+  const std::optional<Role> role = role_of(request.authorization);
   if (!role) {
     return error(401, "unauthorized",
                  request.authorization.empty() ? "no token: send Authorization: Bearer TOKEN" : "wrong token");
@@ -288,7 +292,7 @@ ApiResponse ControlApi::variable(std::string_view name) {
   return reply(std::move(doc));
 }
 
-ApiResponse ControlApi::wait(Command command) {
+ApiResponse ControlApi::wait(const Command& command) {
   if (command.duration_ns > kMaxWaitNs)
     return error(400, "bad_command", fmt::format("wait: at most {}s over the network", kMaxWaitNs / 1'000'000'000));
   const Reply r = gate_.execute(command);  // announces the wait; Control itself waits for nobody

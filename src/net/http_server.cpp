@@ -9,6 +9,8 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "chimera/net/variable_streams.hpp"
+
 namespace chimera::net {
 
 namespace {
@@ -96,6 +98,8 @@ Result<std::unique_ptr<HttpServer>> HttpServer::start(ControlApi& api, const Lis
   }
   server->port_ = bound[0].port;
   mg_set_request_handler(server->context_, "/api", serve_api, server.get());
+  mg_set_websocket_handler(server->context_, "/api/stream", stream_connect, stream_ready, stream_data, stream_close,
+                           server.get());
   mg_set_request_handler(server->context_, "/", serve_page, server.get());
   return server;
 }
@@ -132,6 +136,46 @@ int HttpServer::serve_api(mg_connection* conn, void* self) {
   const ApiResponse response = server.api_.handle(request);
   send(conn, response.status, "application/json", response.body, response.allow);
   return response.status;
+}
+
+int HttpServer::stream_connect(const mg_connection* conn, void* self) {
+  auto& server = *static_cast<HttpServer*>(self);
+  const mg_request_info* info = mg_get_request_info(conn);
+  // A browser cannot set headers on a WebSocket: the token may come as ?access_token= (RFC 6750).
+  std::string authorization;
+  if (const char* header = mg_get_header(conn, "Authorization"); header != nullptr) authorization = header;
+  if (authorization.empty() && info->query_string != nullptr) {
+    std::array<char, 256> token{};
+    const std::string_view query = info->query_string;
+    if (mg_get_var(query.data(), query.size(), "access_token", token.data(), token.size()) > 0)
+      authorization = std::string("Bearer ") + token.data();
+  }
+  if (server.api_.closing() || !server.api_.role_of(authorization)) return 1;  // refused: closed at once
+  return server.streams_.load(std::memory_order_relaxed) >= kMaxStreams ? 1 : 0;
+}
+
+void HttpServer::stream_ready(mg_connection* conn, void* self) {
+  auto& server = *static_cast<HttpServer*>(self);
+  server.streams_.fetch_add(1, std::memory_order_relaxed);
+  mg_set_user_connection_data(conn, new VariableStream(server.api_.gate(), conn));  // owned until stream_close
+}
+
+int HttpServer::stream_data(mg_connection* conn, int bits, char* data, std::size_t size, void* /*self*/) {
+  constexpr int kOpcodeMask = 0x0f;
+  const int opcode = bits & kOpcodeMask;
+  if (opcode == MG_WEBSOCKET_OPCODE_CONNECTION_CLOSE) return 0;
+  auto* stream = static_cast<VariableStream*>(mg_get_user_connection_data(conn));
+  if (opcode == MG_WEBSOCKET_OPCODE_TEXT && stream != nullptr) stream->receive(std::string_view(data, size));
+  return 1;
+}
+
+void HttpServer::stream_close(const mg_connection* conn, void* self) {
+  auto& server = *static_cast<HttpServer*>(self);
+  auto* stream = static_cast<VariableStream*>(mg_get_user_connection_data(conn));
+  if (stream == nullptr) return;
+  delete stream;  // NOLINT(cppcoreguidelines-owning-memory): civetweb holds it as a void* from stream_ready
+  mg_set_user_connection_data(conn, nullptr);
+  server.streams_.fetch_sub(1, std::memory_order_relaxed);
 }
 
 int HttpServer::serve_page(mg_connection* conn, void* /*self*/) {

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -50,6 +51,13 @@ class ControlApi {
   /// serialised by the gate. Not real-time safe.
   ApiResponse handle(const ApiRequest& request);
 
+  /// The role of an Authorization header's bearer token; none for no or a wrong token.
+  [[nodiscard]] std::optional<Role> role_of(std::string_view authorization) const;
+  /// The gate the API drives, for the streams beside it.
+  [[nodiscard]] ControlGate& gate() const { return gate_; }
+  /// Whether close() was called.
+  [[nodiscard]] bool closing() const { return closing_; }
+
   /// From now on requests get 503 and a `wait` under way returns early: the server is closing.
   void close();
 
@@ -62,7 +70,7 @@ class ControlApi {
   ApiResponse command(Role role, std::string_view body);
   ApiResponse status();
   ApiResponse variable(std::string_view name);
-  ApiResponse wait(Command command);
+  ApiResponse wait(const Command& command);
 
   ControlGate& gate_;
   AccessTokens tokens_;

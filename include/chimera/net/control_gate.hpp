@@ -8,6 +8,7 @@
 #include <string>
 #include <string_view>
 #include <utility>
+#include <vector>
 
 #include "chimera/control/control.hpp"
 #include "chimera/control/subsystem.hpp"
@@ -40,6 +41,10 @@ class ControlGate {
     std::lock_guard<std::mutex> lock(mutex_);
     return std::forward<F>(f)(control_, subsystem_);
   }
+
+  /// The current value of a variable, without the gate: Subsystem::get() is safe from any
+  /// thread and reads the table as any reader does, so a stream never waits for a command.
+  [[nodiscard]] Result<std::vector<double>> sample(std::string_view variable) const { return subsystem_.get(variable); }
 
   /// The subsystem's clock; fixed at creation, so no lock.
   [[nodiscard]] ClockKind clock() const { return subsystem_.clock(); }

@@ -2,6 +2,8 @@
 // The network control API on HTTP, served by civetweb: /api/ is ControlApi, / a placeholder
 // page until the browser's page (issue 14, section 2) is served there.
 
+#include <atomic>
+#include <cstddef>
 #include <memory>
 #include <string>
 
@@ -23,6 +25,8 @@ class HttpServer {
   /// How long a request may take to arrive, and a reply to be taken by the client, before the
   /// connection is dropped: a stalled or slow client frees its thread after this.
   static constexpr int kRequestTimeoutMs = 5000;
+  /// Open WebSocket streams at most (each has a thread of its own); more are refused.
+  static constexpr int kMaxStreams = 32;
 
   /// Listens on `address` and serves `api` until stop() or destruction. `api` must outlive
   /// the server. An address that cannot be bound is an Errc::kSystem error naming it.
@@ -44,11 +48,16 @@ class HttpServer {
   HttpServer(ControlApi& api, ListenAddress address) : api_(api), address_(std::move(address)) {}
   static int serve_api(mg_connection* conn, void* self);
   static int serve_page(mg_connection* conn, void* self);
+  static int stream_connect(const mg_connection* conn, void* self);
+  static void stream_ready(mg_connection* conn, void* self);
+  static int stream_data(mg_connection* conn, int bits, char* data, std::size_t size, void* self);
+  static void stream_close(const mg_connection* conn, void* self);
 
   ControlApi& api_;
   ListenAddress address_;
   mg_context* context_ = nullptr;
   int port_ = 0;
+  std::atomic<int> streams_{0};  // open WebSocket streams; relaxed: a bound, not a handshake
 };
 
 }  // namespace chimera::net
