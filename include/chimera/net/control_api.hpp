@@ -38,7 +38,7 @@ bool verb_needs_operator(Verb verb);
 class ControlApi {
  public:
   /// The largest request body taken; a larger one is refused unread (413).
-  static constexpr std::size_t kMaxBodyBytes = 64 * 1024;
+  static constexpr std::size_t kMaxBodyBytes = std::size_t{64} * 1024;
   /// The longest `wait` over the network: a request thread is not parked for longer.
   static constexpr std::int64_t kMaxWaitNs = 60'000'000'000;
 

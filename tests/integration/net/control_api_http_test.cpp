@@ -304,7 +304,7 @@ TEST_F(ControlApiHttpTest, AViewerTokenReadsButCannotWrite) {
 TEST_F(ControlApiHttpTest, BodiesLargerThanTheBoundAreRefused) {
   auto p = start();
   ASSERT_GT(port_, 0) << p->err();
-  constexpr std::size_t kBound = 64 * 1024;
+  constexpr std::size_t kBound = std::size_t{64} * 1024;
   // Declared too large: refused before a byte of it is read.
   HttpRequest declared{"POST", "/api/command", kOperator};
   declared.body = R"({"command": "off pid"})";
