@@ -11,7 +11,8 @@ set(_chimera_cmake_dir ${CMAKE_INSTALL_LIBDIR}/cmake/chimera)
 install(TARGETS chimera_lib EXPORT chimeraTargets
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
-install(DIRECTORY include/chimera DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+# Not chimera/net: the network API is the chimera command's (src/net), not part of libchimera.
+install(DIRECTORY include/chimera DESTINATION ${CMAKE_INSTALL_INCLUDEDIR} PATTERN net EXCLUDE)
 install(FILES ${CHIMERA_GENERATED_INCLUDE_DIR}/chimera/module_abi.hpp DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/chimera)
 install(EXPORT chimeraTargets NAMESPACE chimera:: DESTINATION ${_chimera_cmake_dir})
 

@@ -13,16 +13,18 @@
 #
 # The parts are static (position-independent) libraries linked whole into one shared library,
 # libchimera (chimera_lib, chimera::chimera), which is what the modules, the command and users link.
+# A part marked APART sits above the runtime and stays out of libchimera: its library is linked
+# only by the programs that use it (net: the network API, so that users never link civetweb).
 
 set(CHIMERA_LAYERS_DIR ${PROJECT_BINARY_DIR}/layers)
 
-# chimera_part(NAME SOURCES src... [DEPENDS part...] [EXPORTS header...] [INCLUDES dir...]
+# chimera_part(NAME [APART] SOURCES src... [DEPENDS part...] [EXPORTS header...] [INCLUDES dir...]
 #              [LIBS lib...] [PUBLIC_LIBS lib...])
 # DEPENDS names the parts below it that it builds on; what those build on comes along (their
 # headers include it). INCLUDES adds include roots of its own (generated headers). The parts do not
 # link each other: they meet in libchimera, so the include paths alone decide what a part may use.
 function(chimera_part name)
-  cmake_parse_arguments(P "" "" "SOURCES;DEPENDS;EXPORTS;INCLUDES;LIBS;PUBLIC_LIBS" ${ARGN})
+  cmake_parse_arguments(P "APART" "" "SOURCES;DEPENDS;EXPORTS;INCLUDES;LIBS;PUBLIC_LIBS" ${ARGN})
   set(target chimera_${name})
   set(stage ${CHIMERA_LAYERS_DIR}/${name})
   file(REMOVE_RECURSE ${stage})
@@ -61,5 +63,7 @@ function(chimera_part name)
   target_link_libraries(${target} PRIVATE ${libs} ${P_LIBS} Threads::Threads)
   target_compile_features(${target} PUBLIC cxx_std_20)
   chimera_warnings(${target})
-  set_property(GLOBAL APPEND PROPERTY CHIMERA_PARTS ${target})
+  if(NOT P_APART)
+    set_property(GLOBAL APPEND PROPERTY CHIMERA_PARTS ${target})
+  endif()
 endfunction()

@@ -28,9 +28,11 @@ struct RunArgs {
   std::optional<std::int64_t> for_ns;
   ClockKind clock = ClockKind::kReal;
   std::optional<std::string> stats_json;
-  bool rt_check = false;  // count allocations in the tasks' real-time methods
+  bool rt_check = false;                  // count allocations in the tasks' real-time methods
+  std::optional<std::string> listen;      // --listen [ADDR:]PORT: the network control API
+  std::optional<std::string> token_file;  // --token-file FILE: its tokens
 };
-/// `chimera run FILE ...`; returns the exit code.
+/// `chimera run FILE ...`, and `chimera serve` (file empty: an empty subsystem); returns the exit code.
 int run_command(const RunArgs& args);
 
 struct AnalyzeArgs {

@@ -14,6 +14,7 @@
 #include "chimera/module/version.hpp"
 #include "commands.hpp"
 #include "exit_codes.hpp"
+#include "network.hpp"
 
 namespace {
 
@@ -68,6 +69,9 @@ int run_main(int argc, char** argv) {
   auto* run_stats_opt = run_cmd->add_option("--stats-json", run_stats, "write per-task timing figures here at exit");
   run_cmd->add_flag("--rt-check", run.rt_check,
                     "count allocations inside each task's on/cycle/off/sync (rt violations in the timing table)");
+  chimera::cli::add_listen_options(*run_cmd, run);
+  chimera::cli::RunArgs serve;
+  auto* serve_cmd = chimera::cli::add_serve_command(app, serve);
 
   chimera::cli::AnalyzeArgs analyze;
   auto* analyze_cmd = chimera::cli::add_analyze_command(app, analyze);
@@ -120,6 +124,7 @@ int run_main(int argc, char** argv) {
     run.clock = run_clock == "virtual" ? chimera::ClockKind::kVirtual : chimera::ClockKind::kReal;
     return chimera::cli::run_command(run);
   }
+  if (serve_cmd->parsed()) return chimera::cli::run_command(serve);
   if (plot_cmd->parsed()) {
     if (plot_output_opt->count() > 0) plot.output = plot_output;
     return chimera::cli::plot_command(plot);

@@ -1,6 +1,7 @@
 // chimera run FILE [--config NAME] [--for DURATION] [--clock real|virtual] [--stats-json FILE]
-// [--rt-check]:
-// starts the subsystem, takes commands from a shell or a script on stdin, stops it cleanly.
+// [--rt-check] [--listen [ADDR:]PORT [--token-file FILE]], and chimera serve (no file):
+// starts the subsystem, takes commands from a shell or a script on stdin (and from the network
+// API, network.hpp), stops it cleanly.
 
 #include <unistd.h>
 
@@ -24,6 +25,7 @@
 #include "exit_codes.hpp"
 #include "line_reader.hpp"
 #include "load_file.hpp"
+#include "network.hpp"
 #include "rt_check_allocator.hpp"
 #include "stop_request.hpp"
 
@@ -57,8 +59,8 @@ Result<void> check_writable(const std::string& path) {
 /// The loop between start and stop: commands in, replies and events out, time kept.
 class Session {
  public:
-  Session(Subsystem& subsystem, const RunArgs& args, bool interactive)
-      : subsystem_(subsystem), control_(subsystem), args_(args), interactive_(interactive) {}
+  Session(Subsystem& subsystem, net::ControlGate& control, const RunArgs& args, bool interactive)
+      : subsystem_(subsystem), control_(control), args_(args), interactive_(interactive) {}
 
   void run() {
     LineReader reader(STDIN_FILENO);
@@ -121,7 +123,7 @@ class Session {
       std::int64_t left = until - subsystem_.now_ns();
       if (args_.for_ns) left = std::min(left, *args_.for_ns - subsystem_.now_ns());
       if (left <= 0) break;
-      subsystem_.run_for(std::min(left, kStepNs));
+      control_.run_for(std::min(left, kStepNs));
       print_events(prompt_shown);
     }
   }
@@ -135,7 +137,7 @@ class Session {
   }
 
   Subsystem& subsystem_;
-  Control control_;
+  net::ControlGate& control_;  // shared with the network API
   const RunArgs& args_;
   bool interactive_;
 };
@@ -147,8 +149,10 @@ int run_command(const RunArgs& args) {
   // in a clean stop (right after start), never in the default action's abrupt exit.
   install_stop_handlers();
   const Registry& registry = Registry::global();
-  auto spec = load_file(args.file, args.config);
+  auto spec = args.file.empty() ? std::optional(empty_subsystem()) : load_file(args.file, args.config);
   if (!spec) return kExitInvalid;
+  auto network_plan = plan_network(args);
+  if (!network_plan) return kExitInvalid;
   if (args.stats_json) {
     if (auto writable = check_writable(*args.stats_json); !writable) {
       fmt::print(stderr, "{}\n", writable.error().message);
@@ -180,8 +184,19 @@ int run_command(const RunArgs& args) {
     out(fmt::format("subsystem '{}' running configuration '{}' on the {} clock; type help for commands\n", spec->name,
                     args.config.value_or(spec->start), args.clock == ClockKind::kVirtual ? "virtual" : "real"));
 
-  Session session(subsystem, args, interactive);
+  net::ControlGate gate(subsystem);
+  std::unique_ptr<Network> network;
+  if (*network_plan) {
+    auto started = Network::start(std::move(**network_plan), gate, spec->name);
+    if (!started) {
+      subsystem.stop();
+      return kExitInvalid;
+    }
+    network = std::move(*started);
+  }
+  Session session(subsystem, gate, args, interactive);
   session.run();
+  network.reset();  // the network API ends before the subsystem stops
 
   // The figures as they stood while the tasks ran; stopping turns every task NOT-CREATED.
   const auto tasks = subsystem.snapshot();

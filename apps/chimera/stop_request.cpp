@@ -33,4 +33,7 @@ void install_stop_handlers() {
 
 bool stop_requested() { return g_stop.load(std::memory_order_relaxed); }
 
+// relaxed: as the handler's store; the loop only needs to see it eventually.
+void request_stop() { g_stop.store(true, std::memory_order_relaxed); }
+
 }  // namespace chimera::cli

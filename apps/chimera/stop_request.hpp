@@ -7,7 +7,9 @@ namespace chimera::cli {
 /// Installs the handlers (without SA_RESTART, so a blocking poll() returns early). A second
 /// signal while the first is pending ends the process the default way, for a stuck stop.
 void install_stop_handlers();
-/// Whether SIGINT or SIGTERM has arrived.
+/// Whether SIGINT or SIGTERM has arrived, or request_stop() was called.
 bool stop_requested();
+/// Asks for the same clean stop as a signal (the network API's `quit`). Any thread.
+void request_stop();
 
 }  // namespace chimera::cli

@@ -1,0 +1,58 @@
+#pragma once
+// The one Control of a running subsystem, shared by everything that drives it: the shell on
+// standard input and the network API's request threads. Control is for one thread at a time;
+// the gate carries out each command whole before the next starts, in arrival order of the lock.
+
+#include <cstdint>
+#include <mutex>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "chimera/control/control.hpp"
+#include "chimera/control/subsystem.hpp"
+
+namespace chimera::net {
+
+class ControlGate {
+ public:
+  /// How long one step of run_for() holds the gate on the virtual clock: commands from other
+  /// drivers wait at most about this much simulated time.
+  static constexpr std::int64_t kStepNs = 50'000'000;
+
+  explicit ControlGate(Subsystem& subsystem) : subsystem_(subsystem), control_(subsystem) {}
+
+  /// Control::execute() and execute_line(), one caller at a time. Not real-time safe.
+  Reply execute(const Command& command);
+  Reply execute_line(std::string_view line);
+  /// Control::drain_events(), one caller at a time.
+  std::string drain_events();
+
+  /// Lets the subsystem run for `ns`. On the virtual clock the caller's thread runs the tasks,
+  /// so each step of at most kStepNs holds the gate (other drivers' commands come in between);
+  /// on the real clock it is a sleep and holds nothing.
+  void run_for(std::int64_t ns);
+
+  /// Runs `f(control, subsystem)` holding the gate: a command and what the caller reads of the
+  /// subsystem right after it, with no other driver's command in between.
+  template <class F>
+  auto exclusive(F&& f) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return std::forward<F>(f)(control_, subsystem_);
+  }
+
+  /// The current value of a variable, without the gate: Subsystem::get() is safe from any
+  /// thread and reads the table as any reader does, so a stream never waits for a command.
+  [[nodiscard]] Result<std::vector<double>> sample(std::string_view variable) const { return subsystem_.get(variable); }
+
+  /// The subsystem's clock; fixed at creation, so no lock.
+  [[nodiscard]] ClockKind clock() const { return subsystem_.clock(); }
+
+ private:
+  Subsystem& subsystem_;
+  std::mutex mutex_;  // held for each command; never by a task's thread
+  Control control_;
+};
+
+}  // namespace chimera::net
