@@ -1,13 +1,14 @@
 #pragma once
-// SIGINT and SIGTERM ask `chimera run` to stop cleanly: the handler only sets a flag that the
-// main loop polls, because nothing else is safe inside a signal handler.
+// SIGINT, SIGTERM and SIGHUP ask `chimera run` to stop cleanly: the handler only sets a flag that
+// the main loop polls, because nothing else is safe inside a signal handler.
 
 namespace chimera::cli {
 
-/// Installs the handlers (without SA_RESTART, so a blocking poll() returns early). A second
-/// signal while the first is pending ends the process the default way, for a stuck stop.
+/// Installs the handlers (without SA_RESTART, so a blocking poll() returns early), and ignores
+/// SIGPIPE. A second signal while the first is pending ends the process the default way, for a
+/// stuck stop, after removing the name of the shared memory this process owns.
 void install_stop_handlers();
-/// Whether SIGINT or SIGTERM has arrived.
+/// Whether SIGINT, SIGTERM or SIGHUP has arrived.
 bool stop_requested();
 
 }  // namespace chimera::cli
