@@ -145,6 +145,7 @@ Result<GlobalTable> GlobalTable::create(std::string_view subsystem_name, std::sp
   // taken. So a region under a name is always complete and always locked by a live owner, or
   // stale; and a creator that dies on the way leaves nothing behind.
   const std::string path = svt_detail::shm_path(shm);
+  // NOLINTNEXTLINE(cppcoreguidelines-pro-type-vararg): open(2) is the one call that makes an O_TMPFILE
   const int fd = ::open(svt_detail::kShmDir, O_TMPFILE | O_RDWR | O_CLOEXEC, 0600);
   if (fd < 0) return sys_error("open(O_TMPFILE) in /dev/shm for", shm);
   // Closed on every path out; a table that is made keeps it open (the lock) until release().

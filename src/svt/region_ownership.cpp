@@ -106,7 +106,7 @@ void remove_if_same(int fd, const char* path) noexcept {
 Result<Existing> inspect_existing(const std::string& path, const std::string& shm) {
   const auto deadline = std::chrono::steady_clock::now() + kOwnerWait;
   for (;;) {
-    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    const int fd = ::shm_open(shm.c_str(), O_RDONLY, 0);  // the file at `path`, close-on-exec
     if (fd < 0) {
       if (errno == ENOENT) return Existing{Existing::Kind::kGone};
       return sys_error("open", shm);
