@@ -5,8 +5,9 @@
 namespace chimera::cli {
 
 /// Installs the handlers (without SA_RESTART, so a blocking poll() returns early), and ignores
-/// SIGPIPE. A second signal while the first is pending ends the process the default way, for a
-/// stuck stop, after removing the name of the shared memory this process owns.
+/// SIGPIPE. Signals within a second of the first are the same request; one after that ends the
+/// process the default way, for a stuck stop, after removing the names of the shared memory
+/// this process owns.
 void install_stop_handlers();
 /// Whether SIGINT, SIGTERM or SIGHUP has arrived.
 bool stop_requested();
