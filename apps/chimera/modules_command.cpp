@@ -1,8 +1,10 @@
 // chimera modules [NAME] [--plugin LIB]...: the module library (with every module library on
-// CHIMERA_MODULE_PATH and those given), or one module's ports, parameters and docs.
+// CHIMERA_MODULE_PATH and those given), or one module's ports, parameters and docs. A library
+// that does not load is named and left out; the rest is listed all the same.
 
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -76,13 +78,16 @@ std::string wrap(std::string_view text, std::size_t width) {
   return out;
 }
 
-// Every library on CHIMERA_MODULE_PATH, then those of --plugin; the first problem is printed.
-bool load_plugins(const std::vector<std::string>& extra) {
+// Every library on CHIMERA_MODULE_PATH, then those of --plugin. One that does not load (broken,
+// built for another Chimera, a duplicate of another) is named, one line each, and the others load
+// on: one bad file on the path must not hide the rest of the library. Returns how many failed.
+std::size_t load_plugins(const std::vector<std::string>& extra) {
+  std::size_t failed = 0;
   const std::vector<std::string> search_path = module_search_path();
   for (const auto& file : plugins_on_path(search_path)) {
-    if (auto loaded = load_plugin(file, file); !loaded) {
+    if (auto loaded = load_plugin(std::filesystem::path(file).filename().string(), file); !loaded) {
       fmt::print(stderr, "CHIMERA_MODULE_PATH: {}\n", loaded.error().message);
-      return false;
+      ++failed;
     }
   }
   for (const auto& name : extra) {
@@ -90,10 +95,17 @@ bool load_plugins(const std::vector<std::string>& extra) {
     auto loaded = found ? load_plugin(name, *found) : Result<LoadedPlugin>(found.error());
     if (!loaded) {
       fmt::print(stderr, "--plugin: {}\n", loaded.error().message);
-      return false;
+      ++failed;
     }
   }
-  return true;
+  return failed;
+}
+
+// The closing line when libraries were left out, so that a listing is never taken for the whole.
+void say_what_is_missing(std::size_t failed) {
+  if (failed == 0) return;
+  fmt::print(stderr, "chimera modules: {} module librar{} did not load (named above); {}\n", failed,
+             failed == 1 ? "y" : "ies", "their modules are missing from what is shown");
 }
 
 void print_list(const Registry& registry) {
@@ -159,19 +171,27 @@ void print_module(const ModuleInfo& m, std::string_view origin) {
 }  // namespace
 
 int modules_command(const ModulesArgs& args) {
-  if (!load_plugins(args.plugins)) return kExitInvalid;
+  const std::size_t failed = load_plugins(args.plugins);
   const Registry& registry = Registry::global();
+  // Like ls over a directory with an unreadable entry: what loaded is shown, what did not is
+  // named on stderr, and the exit code (2) says the answer is not whole.
+  const int code = failed == 0 ? kExitOk : kExitInvalid;
   if (!args.name) {
     print_list(registry);
-    return kExitOk;
+    std::fflush(stdout);  // the list first, then the closing line, whatever the streams are
+    say_what_is_missing(failed);
+    return code;
   }
   const ModuleInfo* module = registry.find(*args.name);
   if (module == nullptr) {
     fmt::print(stderr, "unknown module '{}' (chimera modules lists them)\n", *args.name);
+    say_what_is_missing(failed);
     return kExitInvalid;
   }
   print_module(*module, registry.origin(module->name));
-  return kExitOk;
+  std::fflush(stdout);
+  say_what_is_missing(failed);
+  return code;
 }
 
 }  // namespace chimera::cli

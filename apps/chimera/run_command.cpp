@@ -11,8 +11,10 @@
 #include <fstream>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include "chimera/config/loader.hpp"
@@ -38,9 +40,18 @@ constexpr std::int64_t kStepNs = 50'000'000;
 constexpr int kPollMs = 50;
 constexpr std::string_view kPrompt = "chimera> ";
 
+// Replies to commands (and the prompt, and the timing table) go to stdout; what the running
+// subsystem says of its own accord (events: a task in ERROR, a switch, a job overdue) and every
+// diagnostic go to stderr, so that a script reading the replies gets only replies.
 void out(std::string_view text) {
   std::fwrite(text.data(), 1, text.size(), stdout);
   std::fflush(stdout);  // replies must reach a script reading the pipe as they happen
+}
+
+void err(std::string_view text) {
+  std::fflush(stdout);  // on a terminal both streams share a screen: keep them in order
+  std::fwrite(text.data(), 1, text.size(), stderr);
+  std::fflush(stderr);
 }
 
 // Refuses a --stats-json path that cannot be written before anything starts, rather than
@@ -84,9 +95,10 @@ class Session {
           if (prompt_shown) out("\n");
           prompt_shown = false;
           // On a terminal Ctrl-D might be taken for quit; say what happens instead.
-          if (interactive_)
-            out(args_.for_ns ? "end of input: running on until --for has passed (Ctrl-C stops now)\n"
-                             : "end of input: running on until Ctrl-C\n");
+          if (interactive_) out(end_of_input_text());
+          // Simulated time without --for has no end of its own: running on would spin a core
+          // forever. The run lasts as long as its input.
+          if (stops_at_end_of_input()) return;
           break;
         case LineReader::Status::kLine: {
           prompt_shown = false;
@@ -103,6 +115,15 @@ class Session {
 
  private:
   [[nodiscard]] bool time_up() const { return args_.for_ns && subsystem_.now_ns() >= *args_.for_ns; }
+  [[nodiscard]] bool stops_at_end_of_input() const {
+    return !args_.for_ns && subsystem_.clock() == ClockKind::kVirtual;
+  }
+  [[nodiscard]] std::string end_of_input_text() const {
+    if (args_.for_ns) return "end of input: running on until --for has passed (Ctrl-C stops now)\n";
+    if (stops_at_end_of_input())
+      return "end of input: stopping (on the virtual clock without --for a run lasts as long as its input)\n";
+    return "end of input: running on until Ctrl-C\n";
+  }
   [[nodiscard]] bool should_end() const { return stop_requested() || time_up(); }
 
   void print_events(bool& prompt_shown) {
@@ -110,7 +131,7 @@ class Session {
     if (events.empty()) return;
     // Keep the operator's prompt usable: events go on their own lines, then the prompt again.
     if (prompt_shown) out("\n");
-    out(events);
+    err(events);
     prompt_shown = false;
   }
 
@@ -128,7 +149,7 @@ class Session {
     }
   }
 
-  // End of input: run on until --for has passed, or without --for until a signal.
+  // End of input: run on until --for has passed, or without --for (real clock) until a signal.
   void run_on() {
     if (args_.for_ns)
       advance(*args_.for_ns - subsystem_.now_ns());
@@ -203,16 +224,20 @@ int run_command(const RunArgs& args) {
   const std::uint64_t switches = subsystem.switches().size();
   subsystem.stop();
   Control control(subsystem);
-  out(control.drain_events());
+  err(control.drain_events());
   out(timing_table(tasks, args.rt_check));
 
-  int code = subsystem.hard_task_failed() ? kExitFailed : kExitOk;
+  // Exit 1 says why in the run's last line: the hard tasks that failed, the modules that could
+  // not release their resources cleanly (a data logger's lost rows), figures that were not written.
+  std::vector<std::string> faults = subsystem.faults();
   if (args.stats_json) {
     if (auto written = write_stats_json(*args.stats_json, tasks, args.clock, switches, args.rt_check); !written) {
-      fmt::print(stderr, "{}\n", written.error().message);
-      code = std::max(code, kExitFailed);
+      err(written.error().message + "\n");
+      faults.push_back(written.error().message);
     }
   }
+  const int code = faults.empty() ? kExitOk : kExitFailed;
+  if (!faults.empty()) err(fmt::format("chimera: exit {}: {}\n", code, fmt::join(faults, "; ")));
   spdlog::debug("run ended with exit code {}", code);
   return code;
 }

@@ -1,6 +1,8 @@
 // data_logger: the paper's data logger (section 3), a task that only gathers data and so has no
 // output ports. Each cycle copies the chosen variables into a preallocated ring; an ordinary
 // thread drains the ring into a CSV file, so the real-time path never formats, writes or waits.
+// A file that cannot be written (a full disk) is said at once, its lost rows counted, and the
+// task's kill reports them, so that the run does not end as if its log were whole.
 
 #include "module_docs/data_logger.hpp"
 
@@ -120,9 +122,14 @@ class DataLogger final : public Module {
     if (file_ == nullptr)
       return Status::fail(
           intern(fmt::format("cannot write the log {}: {}", path_, std::generic_category().message(errno))));
+    // Unbuffered: out_ is the buffer, so each write's outcome is known at once, with its rows.
+    (void)std::setvbuf(file_, nullptr, _IONBF, 0);
     out_.reserve(kWriteChunk + 4096);
     write_header();
+    // A file that takes nothing (a full disk, /dev/full) is refused before the run starts.
+    if (write_failed_) return Status::fail(intern(fmt::format("cannot write the log {}: {}", path_, write_error_)));
     timing_ = &ctx.timing();
+    writing_ = true;  // before the thread: its start makes it visible there
     writer_ = std::thread([this] { write_loop(); });
     return Status::ok();
   }
@@ -157,6 +164,12 @@ class DataLogger final : public Module {
     if (dropped > 0)
       spdlog::warn("{}: {} rows not logged to {}: the ring of {} rows was full (raise capacity)", task_, dropped, path_,
                    ring_->rows());
+    // The log is not whole: the run must not end as if it were (chimera run exits 1 on this).
+    // (A header that could not be written failed init, which said so.)
+    if (write_failed_ && writing_)
+      return Status::fail(intern(fmt::format("{} rows lost: the log {} could not be written from t = {} s on: {}",
+                                             lost_rows_, path_, first_lost_t_, write_error_)));
+    if (!failure_.empty()) return Status::fail(intern(fmt::format("the log {} is incomplete: {}", path_, failure_)));
     return Status::ok();
   }
 
@@ -197,24 +210,47 @@ class DataLogger final : public Module {
     flush_out();
   }
 
+  // Writes what out_ holds. The first failure (a full disk) is said at once; from then on the
+  // rows are only counted, so that the ring keeps draining and the cycle never waits on a file
+  // that will not take them.
   void flush_out() {
-    if (!out_.empty()) (void)std::fwrite(out_.data(), 1, out_.size(), file_);
+    if (!out_.empty() && !write_failed_ && std::fwrite(out_.data(), 1, out_.size(), file_) != out_.size())
+      note_write_failure(errno);
     out_.clear();
+    rows_in_out_ = 0;
+  }
+
+  void note_write_failure(int error) {
+    write_failed_ = true;
+    write_error_ = std::generic_category().message(error);
+    // The rows of the chunk being written are lost (some of their lines may be in the file, cut).
+    lost_rows_ += rows_in_out_;
+    first_lost_t_ = chunk_first_t_;
+    if (!writing_) return;  // the header, in init: init says it
+    spdlog::error(
+        "{}: cannot write the log {}: {}; its rows from t = {} s on are lost (counted; the run reports them "
+        "at exit)",
+        task_, path_, write_error_, first_lost_t_);
   }
 
   // Formats every row the ring holds. In steady state it allocates nothing: the buffer keeps its
-  // capacity and the FILE its buffer.
+  // capacity (the FILE has none).
   void drain() {
     ring_->drain([&](const double* row) {
+      if (write_failed_) {
+        ++lost_rows_;
+        return;
+      }
+      if (rows_in_out_ == 0) chunk_first_t_ = row[0];
       for (std::size_t i = 0; i < ring_->width(); ++i) {
         if (i != 0) out_.push_back(',');
         fmt::format_to(std::back_inserter(out_), "{}", row[i]);
       }
       out_.push_back('\n');
+      ++rows_in_out_;
       if (out_.size() >= kWriteChunk) flush_out();
     });
     flush_out();
-    (void)std::fflush(file_);
   }
 
   void write_loop() {
@@ -266,6 +302,14 @@ class DataLogger final : public Module {
   std::FILE* file_ = nullptr;
   std::string out_;
   std::string failure_;
+  // What could not be written (the writer's alone until it is joined, then kill's).
+  bool writing_ = false;  // the run is on: a failure is said at once
+  bool write_failed_ = false;
+  std::string write_error_;
+  std::uint64_t lost_rows_ = 0;
+  std::size_t rows_in_out_ = 0;  // rows formatted since the last successful write
+  double chunk_first_t_ = 0;     // t of the first of them
+  double first_lost_t_ = 0;
   std::thread writer_;
   std::mutex mutex_;  // guards stop_ and wake_, never taken by a real-time cycle
   std::condition_variable wake_cv_;

@@ -56,6 +56,25 @@ struct Subsystem::Impl {
   // takes it to remove the table.
   mutable std::mutex table_mutex;
   std::atomic<bool> stopped{false};  // written under ops_mutex; read by queries on their own (seq_cst: rare, simplest)
+  // Per task, what the operator and the run need to know beyond its state, written under
+  // ops_mutex and read by queries that do not take it (notes_mutex):
+  // which of its failures a clear (or a kill) took it out of ERROR from, so that status tells a
+  // past error from the present state;
+  struct ErrorEnd {
+    std::uint64_t failure = 0;  // TaskFailure::number; 0: none ended yet
+    Signal by = Signal::kClear;
+    std::int64_t at_ns = 0;
+  };
+  // and what its module reported when a kill found a fault (whole: an event's text is bounded).
+  mutable std::mutex notes_mutex;
+  std::vector<ErrorEnd> error_ends;
+  std::vector<std::string> kill_faults;
+
+  void note_kill(std::size_t task, const Result<void>& killed) {
+    if (killed || killed.error().code != Errc::kModuleFault) return;
+    std::lock_guard<std::mutex> notes(notes_mutex);
+    kill_faults[task] = killed.error().message;
+  }
 };
 
 Subsystem::Subsystem() : impl_(std::make_unique<Impl>()) {}
@@ -100,6 +119,8 @@ Result<std::unique_ptr<Subsystem>> Subsystem::create(const SubsystemSpec& spec, 
   m.requests = std::make_unique<SubsystemRequestBoard>(configuration_names(m.spec), resolved.tasks.size());
   m.tasks = std::make_unique<TaskSet>(resolved, *m.table, m.requests.get());
   m.events = std::make_unique<EventLog>(m.tasks->size());
+  m.error_ends.resize(m.tasks->size());
+  m.kill_faults.resize(m.tasks->size());
   for (Task* t : m.tasks->pointers()) t->set_rt_check(m.options.rt_check);
   ExecutiveSetup setup;
   setup.clock = m.options.clock;
@@ -151,8 +172,15 @@ Result<void> Subsystem::signal(std::string_view task, Signal signal) {
   if (m.stopped) return make_error(Errc::kState, "the subsystem is stopped");
   const auto i = m.tasks->index_of(task);
   if (!i) return make_error(Errc::kNotFound, fmt::format("no task named '{}'", task));
+  const bool was_in_error = (*m.tasks)[*i].state() == TaskState::kError;
   auto r = m.executive->signal(*i, signal);
   m.events->collect(*m.tasks);
+  if (signal == Signal::kKill) m.note_kill(*i, r);
+  if (was_in_error && (*m.tasks)[*i].state() != TaskState::kError) {
+    const std::uint64_t failure = m.events->last_failure(*i).number;
+    std::lock_guard<std::mutex> notes(m.notes_mutex);
+    m.error_ends[*i] = Impl::ErrorEnd{failure, signal, m.executive->now_ns()};
+  }
   return r;
 }
 
@@ -186,7 +214,13 @@ void Subsystem::stop() {
   m.executive->stop_serving();
   std::lock_guard<std::mutex> lock(m.ops_mutex);
   if (m.stopped) return;
-  m.executive->shutdown();  // every task off, then killed; the threads end
+  // The paper's two-step termination, every task off, then every task killed, signal by signal
+  // so that what a module's kill reports is kept; then the executive ends its threads.
+  for (std::size_t i = 0; i < m.tasks->size(); ++i)
+    if ((*m.tasks)[i].state() == TaskState::kOn) (void)m.executive->signal(i, Signal::kOff);
+  for (std::size_t i = 0; i < m.tasks->size(); ++i)
+    if ((*m.tasks)[i].state() != TaskState::kNotCreated) m.note_kill(i, m.executive->signal(i, Signal::kKill));
+  m.executive->shutdown();
   m.stopped = true;
   m.events->collect(*m.tasks);  // what off and kill reported stays readable, as do the tasks' figures
   std::lock_guard<std::mutex> table(m.table_mutex);
@@ -244,8 +278,25 @@ std::vector<TaskSnapshot> Subsystem::snapshot() const {
   std::vector<TaskSnapshot> out;
   for (std::size_t i = 0; i < m.tasks->size(); ++i) {
     const Task& t = (*m.tasks)[i];
-    out.push_back(TaskSnapshot{t.name(), t.spec().module, t.state(), t.period_ns(), m.executive->cpu_of(i),
-                               t.stats().snapshot(), m.events->last_error(i)});
+    const TaskFailure failure = m.events->last_failure(i);
+    TaskSnapshot snap;
+    snap.name = t.name();
+    snap.module = t.spec().module;
+    snap.state = t.state();
+    snap.period_ns = t.period_ns();
+    snap.cpu = m.executive->cpu_of(i);
+    snap.stats = t.stats().snapshot();
+    snap.last_error = failure.text;
+    snap.last_error_ns = failure.time_ns;
+    {
+      std::lock_guard<std::mutex> notes(m.notes_mutex);
+      const Impl::ErrorEnd& end = m.error_ends[i];
+      if (failure.number != 0 && end.failure == failure.number) {
+        snap.error_ended_by = end.by;
+        snap.error_ended_ns = end.at_ns;
+      }
+    }
+    out.push_back(std::move(snap));
   }
   return out;
 }
@@ -262,5 +313,23 @@ GlobalTable& SubsystemTestAccess::table(Subsystem& subsystem) {
 }
 
 bool Subsystem::hard_task_failed() const { return impl_->tasks && impl_->tasks->hard_task_failed(); }
+
+std::vector<std::string> Subsystem::faults() const {
+  const Impl& m = *impl_;
+  std::vector<std::string> out;
+  if (!m.tasks) return out;
+  m.events->collect(*m.tasks);
+  for (std::size_t i = 0; i < m.tasks->size(); ++i) {
+    const Task& t = (*m.tasks)[i];
+    if (t.hard() && t.ever_in_error()) {
+      const std::string last = m.events->last_error(i);
+      out.push_back(last.empty() ? fmt::format("hard task {} entered ERROR", t.name())
+                                 : fmt::format("hard task {} entered ERROR ({})", t.name(), last));
+    }
+    std::lock_guard<std::mutex> notes(m.notes_mutex);
+    if (!m.kill_faults[i].empty()) out.push_back(fmt::format("task {}", m.kill_faults[i]));
+  }
+  return out;
+}
 
 }  // namespace chimera

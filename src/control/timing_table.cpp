@@ -28,6 +28,21 @@ std::vector<std::string> identity_cells(const TaskSnapshot& t) {
           fmt::format("{}", t.stats.missed)};
 }
 
+// A time on the subsystem's clock, as status shows it: seconds since start.
+std::string clock_time(std::int64_t ns) { return fmt::format("{:.3f} s", static_cast<double>(ns) / 1e9); }
+
+// The last error as status shows it: as it is while it is the task's state; once an operator's
+// clear (or a kill) has ended it, or error() recovered from it, with when, so that an old error
+// is never read as the task's present.
+std::string last_error_cell(const TaskSnapshot& t) {
+  if (t.last_error.empty()) return {};
+  if (t.error_ended_by)
+    return fmt::format("{} at {}, was: {}", *t.error_ended_by == Signal::kClear ? "cleared" : "killed",
+                       clock_time(t.error_ended_ns), t.last_error);
+  if (t.state == TaskState::kError) return t.last_error;
+  return fmt::format("past, at {}: {}", clock_time(t.last_error_ns), t.last_error);
+}
+
 }  // namespace
 
 std::string status_table(std::span<const TaskSnapshot> tasks) {
@@ -41,7 +56,7 @@ std::string status_table(std::span<const TaskSnapshot> tasks) {
   for (const auto& t : tasks) {
     auto cells = identity_cells(t);
     cells.insert(cells.begin() + 3, fmt::format("{}", t.cpu));
-    if (any_error) cells.push_back(t.last_error);
+    if (any_error) cells.push_back(last_error_cell(t));
     table.add_row(std::move(cells));
   }
   return table.render();

@@ -11,8 +11,10 @@ void EventLog::collect(TaskSet& tasks) {
   for (std::size_t i = 0; i < tasks.size(); ++i) {
     while (tasks[i].events().pop(e)) {
       pending_.push_back(Event{e.time_ns, tasks[i].name(), e.text.data()});
-      if (std::strstr(e.text.data(), "ERROR") != nullptr || std::strstr(e.text.data(), "failed") != nullptr)
-        last_error_[i] = e.text.data();
+      if (std::strstr(e.text.data(), "ERROR") != nullptr || std::strstr(e.text.data(), "failed") != nullptr) {
+        TaskFailure& f = last_failure_[i];
+        f = TaskFailure{e.text.data(), e.time_ns, f.number + 1};
+      }
     }
   }
 }
@@ -34,7 +36,12 @@ std::vector<Event> EventLog::drain() {
 
 std::string EventLog::last_error(std::size_t task) const {
   std::lock_guard<std::mutex> lock(mutex_);
-  return last_error_[task];
+  return last_failure_[task].text;
+}
+
+TaskFailure EventLog::last_failure(std::size_t task) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return last_failure_[task];
 }
 
 }  // namespace chimera

@@ -5,6 +5,7 @@
 // thread. Exported to the parts above. Not real-time safe.
 
 #include <cstddef>
+#include <cstdint>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -14,9 +15,16 @@
 
 namespace chimera {
 
+/// A task's last method failure or ERROR, as its event said it.
+struct TaskFailure {
+  std::string text;          // "" if none
+  std::int64_t time_ns = 0;  // on the subsystem's clock
+  std::uint64_t number = 0;  // how many failures the task has had so far (0: none): tells one from the next
+};
+
 class EventLog {
  public:
-  explicit EventLog(std::size_t tasks) : last_error_(tasks) {}
+  explicit EventLog(std::size_t tasks) : last_failure_(tasks) {}
 
   /// Moves every task's real-time events into the log and notes each task's last failure.
   void collect(TaskSet& tasks);
@@ -26,11 +34,13 @@ class EventLog {
   std::vector<Event> drain();
   /// Task `task`'s last method failure or ERROR, "" if none.
   [[nodiscard]] std::string last_error(std::size_t task) const;
+  /// The same with its time and number.
+  [[nodiscard]] TaskFailure last_failure(std::size_t task) const;
 
  private:
   mutable std::mutex mutex_;
   std::vector<Event> pending_;
-  std::vector<std::string> last_error_;
+  std::vector<TaskFailure> last_failure_;
 };
 
 }  // namespace chimera

@@ -4,26 +4,26 @@
 #include "chimera/svt/global_table.hpp"
 
 #include <fcntl.h>
-#include <signal.h>
+#include <sys/file.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <cerrno>
-#include <chrono>
 #include <cstring>
 #include <limits>
 #include <new>
 #include <set>
 #include <system_error>
-#include <thread>
 #include <utility>
 #include <vector>
 
 #include <fmt/format.h>
 
 #include "chimera/svt/detail/shm_layout.hpp"
+#include "region_ownership.hpp"
 
 namespace chimera {
 
@@ -36,9 +36,6 @@ using Word = std::atomic_ref<std::uint64_t>;
 
 /// Largest payload of one variable; keeps byte counts in 32 bits everywhere.
 constexpr std::uint64_t kMaxVarBytes = std::uint64_t{1} << 28;
-/// How long create() waits for a region that exists but has no owner pid yet (its creator is
-/// between shm_open and its first store) before calling it stale.
-constexpr auto kOwnerWait = std::chrono::milliseconds(200);
 
 Error sys_error(std::string_view what, const std::string& shm) {
   return make_error(Errc::kSystem, fmt::format("{}({}) failed: {}", what, shm,
@@ -54,6 +51,8 @@ class FdGuard {
   ~FdGuard() {
     if (fd_ >= 0) ::close(fd_);
   }
+  /// Hands the descriptor over: the guard no longer closes it.
+  int release() noexcept { return std::exchange(fd_, -1); }
 
  private:
   int fd_;
@@ -72,45 +71,6 @@ Result<void> check_subsystem_name(std::string_view name) {
     }
   }
   return {};
-}
-
-bool process_alive(std::uint64_t pid) {
-  if (pid == 0 || pid > static_cast<std::uint64_t>(std::numeric_limits<pid_t>::max())) return false;
-  // EPERM means it exists but belongs to someone else: alive all the same.
-  return ::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH;
-}
-
-/// What create() found under a name that already exists.
-struct Existing {
-  enum class Kind { kGone, kStale, kLive } kind;
-  std::uint64_t pid = 0;
-};
-
-Result<Existing> inspect_existing(const std::string& shm) {
-  const auto deadline = std::chrono::steady_clock::now() + kOwnerWait;
-  for (;;) {
-    const int fd = ::shm_open(shm.c_str(), O_RDONLY, 0);
-    if (fd < 0) {
-      if (errno == ENOENT) return Existing{Existing::Kind::kGone};
-      return sys_error("shm_open", shm);
-    }
-    FdGuard guard(fd);
-    struct stat st {};
-    if (::fstat(fd, &st) != 0) return sys_error("fstat", shm);
-    std::uint64_t pid = 0;
-    if (static_cast<std::uint64_t>(st.st_size) >= sizeof(Header)) {
-      void* p = ::mmap(nullptr, sizeof(Header), PROT_READ, MAP_SHARED, fd, 0);
-      if (p == MAP_FAILED) return sys_error("mmap", shm);
-      auto* header = object_at<Header>(static_cast<std::byte*>(p), 0);
-      // Relaxed: the pid is a value on its own; nothing else of the region is read here.
-      pid = Word(header->owner_pid).load(std::memory_order_relaxed);
-      ::munmap(p, sizeof(Header));
-    }
-    if (pid != 0) return Existing{process_alive(pid) ? Existing::Kind::kLive : Existing::Kind::kStale, pid};
-    // No pid yet: a creator may be between shm_open and its first store. Give it a moment.
-    if (std::chrono::steady_clock::now() >= deadline) return Existing{Existing::Kind::kStale};
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  }
 }
 
 Result<void> check_vars(std::span<const VarSpec> vars) {
@@ -180,51 +140,48 @@ Result<GlobalTable> GlobalTable::create(std::string_view subsystem_name, std::sp
     total += svt_detail::block_bytes(svt_detail::payload_words(var.shape.bytes()));
   }
 
-  // O_EXCL: exactly one process owns a name. An existing region is refused if its owner lives,
-  // and replaced if it is dead. Three rounds cover a region removed or replaced meanwhile.
-  int fd = -1;
-  for (int round = 0; round < 3 && fd < 0; ++round) {
-    fd = ::shm_open(shm.c_str(), O_CREAT | O_EXCL | O_RDWR, 0600);
-    if (fd >= 0) break;
-    if (errno != EEXIST) return sys_error("shm_open", shm);
-    auto existing = inspect_existing(shm);
-    if (!existing) return existing.error();
-    if (existing->kind == Existing::Kind::kLive) {
-      return make_error(Errc::kSystem, fmt::format("subsystem '{}' is already running (pid {}); shared memory {}",
-                                                   subsystem_name, existing->pid, shm));
-    }
-    if (existing->kind == Existing::Kind::kStale && ::shm_unlink(shm.c_str()) != 0 && errno != ENOENT) {
-      return sys_error("shm_unlink of a stale", shm);
-    }
-  }
-  if (fd < 0) {
-    return make_error(Errc::kSystem, fmt::format("could not create shared memory {}: another process keeps "
-                                                 "creating it",
-                                                 shm));
-  }
+  // The region is made whole before it has a name: an unnamed file in /dev/shm, locked, its
+  // memory reserved, laid out; then linked under its name in one step that fails if the name is
+  // taken. So a region under a name is always complete and always locked by a live owner, or
+  // stale; and a creator that dies on the way leaves nothing behind.
+  const std::string path = svt_detail::shm_path(shm);
+  // NOLINTNEXTLINE(cppcoreguidelines-pro-type-vararg): open(2) is the one call that makes an O_TMPFILE
+  const int fd = ::open(svt_detail::kShmDir, O_TMPFILE | O_RDWR | O_CLOEXEC, 0600);
+  if (fd < 0) return sys_error("open(O_TMPFILE) in /dev/shm for", shm);
+  // Closed on every path out; a table that is made keeps it open (the lock) until release().
   FdGuard guard(fd);
-  auto fail = [&](std::string_view what) {
-    Error e = sys_error(what, shm);
-    ::shm_unlink(shm.c_str());
-    return e;
-  };
-  // shm_open applied the umask; state the mode outright.
-  if (::fchmod(fd, 0600) != 0) return fail("fchmod");
-  if (::ftruncate(fd, static_cast<off_t>(total)) != 0) return fail("ftruncate");
+  // The owner's lock (region_ownership.hpp): nobody else can see this file yet, so it is ours.
+  if (::flock(fd, LOCK_EX | LOCK_NB) != 0) return sys_error("flock", shm);
+  // O_TMPFILE applied the umask; state the mode outright.
+  if (::fchmod(fd, 0600) != 0) return sys_error("fchmod", shm);
+  if (::ftruncate(fd, static_cast<off_t>(total)) != 0) return sys_error("ftruncate", shm);
+  // Every page now, not at its first touch: a full /dev/shm is this message, never a SIGBUS in
+  // the middle of a run.
+  if (const int e = ::posix_fallocate(fd, 0, static_cast<off_t>(total)); e != 0) {
+    if (e == ENOSPC) {
+      struct statvfs fs {};
+      const std::uint64_t free_bytes =
+          ::fstatvfs(fd, &fs) == 0 ? std::uint64_t{fs.f_bavail} * fs.f_frsize : std::uint64_t{0};
+      return make_error(Errc::kSystem, fmt::format("no room in {} for the state variable table of subsystem '{}': "
+                                                   "it needs {} bytes, {} are free (shared memory {})",
+                                                   svt_detail::kShmDir, subsystem_name, total, free_bytes, shm));
+    }
+    errno = e;
+    return sys_error("posix_fallocate", shm);
+  }
   void* p = ::mmap(nullptr, total, PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
-  if (p == MAP_FAILED) return fail("mmap");
+  if (p == MAP_FAILED) return sys_error("mmap", shm);
 
   GlobalTable table;
   table.shm_name_ = shm;
   table.base_ = static_cast<std::byte*>(p);
   table.mapped_bytes_ = total;
-  table.owner_ = true;
 
   // ftruncate zero-filled the region: every version, seq and payload word starts at 0, and the
-  // placement news below default-initialise, leaving those zeros (a starter may be reading them).
+  // placement news below default-initialise, leaving those zeros.
   auto* header = new (table.base_) Header;  // default-init: no store over the zeros
-  // Relaxed: a starter reads the pid alone (inspect_existing); it is stored first so that the
-  // window in which this region has no owner is as short as possible.
+  // Relaxed: the region has no name yet, so nobody else reads it; the pid is for messages (and
+  // tells a forked child, which inherits the mapping, that it is not the creator).
   Word(header->owner_pid).store(static_cast<std::uint64_t>(::getpid()), std::memory_order_relaxed);
   header->layout_version = svt_detail::kLayoutVersion;
   header->layout_fingerprint = svt_detail::kLayoutFingerprint;
@@ -241,6 +198,34 @@ Result<GlobalTable> GlobalTable::create(std::string_view subsystem_name, std::sp
   }
   // Release: a process that attaches and sees the magic (acquire) sees the whole layout above.
   Word(header->magic).store(svt_detail::kMagic, std::memory_order_release);
+
+  // Noted before it has a name, so that a signal that ends the process the abrupt way from the
+  // moment it has one removes it (the note checks the name is still this region's).
+  table.owned_note_ = svt_detail::note_owned(fd, path);
+  // An existing name is refused if its owner lives and reclaimed if it is gone. Three rounds
+  // cover a name removed or taken again meanwhile.
+  const std::string self = fmt::format("/proc/self/fd/{}", fd);
+  bool named = false;
+  for (int round = 0; round < 3 && !named; ++round) {
+    if (::linkat(AT_FDCWD, self.c_str(), AT_FDCWD, path.c_str(), AT_SYMLINK_FOLLOW) == 0) {
+      named = true;
+      break;
+    }
+    if (errno != EEXIST) return sys_error("linkat", shm);
+    auto existing = svt_detail::inspect_existing(path, shm);
+    if (!existing) return existing.error();
+    if (existing->kind == svt_detail::Existing::Kind::kLive) {
+      return make_error(Errc::kSystem, fmt::format("subsystem '{}' is already running (pid {}); shared memory {}",
+                                                   subsystem_name, existing->pid, shm));
+    }
+  }
+  if (!named) {
+    return make_error(Errc::kSystem, fmt::format("could not create shared memory {}: another process keeps "
+                                                 "creating it",
+                                                 shm));
+  }
+  table.owner_ = true;
+  table.lock_fd_ = guard.release();
   table.locate_blocks();
   return table;
 }
@@ -297,7 +282,9 @@ GlobalTable::GlobalTable(GlobalTable&& other) noexcept
       base_(std::exchange(other.base_, nullptr)),
       blocks_(std::move(other.blocks_)),
       mapped_bytes_(std::exchange(other.mapped_bytes_, 0)),
-      owner_(std::exchange(other.owner_, false)) {}
+      owner_(std::exchange(other.owner_, false)),
+      lock_fd_(std::exchange(other.lock_fd_, -1)),
+      owned_note_(std::exchange(other.owned_note_, -1)) {}
 
 GlobalTable& GlobalTable::operator=(GlobalTable&& other) noexcept {
   if (this != &other) {
@@ -307,6 +294,8 @@ GlobalTable& GlobalTable::operator=(GlobalTable&& other) noexcept {
     blocks_ = std::move(other.blocks_);
     mapped_bytes_ = std::exchange(other.mapped_bytes_, 0);
     owner_ = std::exchange(other.owner_, false);
+    lock_fd_ = std::exchange(other.lock_fd_, -1);
+    owned_note_ = std::exchange(other.owned_note_, -1);
   }
   return *this;
 }
@@ -322,12 +311,21 @@ void GlobalTable::release() noexcept {
   const bool creator_here =
       Word(header->owner_pid).load(std::memory_order_relaxed) == static_cast<std::uint64_t>(::getpid());
   ::munmap(base_, mapped_bytes_);
-  if (owner_ && creator_here) ::shm_unlink(shm_name_.c_str());
+  // The name goes while the lock is still held (closing the descriptor drops it), and only if it
+  // is still this region's.
+  if (owner_ && creator_here && lock_fd_ >= 0)
+    svt_detail::remove_if_same(lock_fd_, svt_detail::shm_path(shm_name_).c_str());
+  svt_detail::forget_owned(owned_note_);  // before the descriptor it names is closed
+  if (lock_fd_ >= 0) ::close(lock_fd_);
   base_ = nullptr;
   blocks_.clear();
   mapped_bytes_ = 0;
   owner_ = false;
+  lock_fd_ = -1;
+  owned_note_ = -1;
 }
+
+void GlobalTable::remove_owned_names_now() noexcept { svt_detail::remove_owned_names_now(); }
 
 void GlobalTable::locate_blocks() {
   const auto* header = object_at<Header>(base_, 0);

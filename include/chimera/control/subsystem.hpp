@@ -48,7 +48,13 @@ struct TaskSnapshot {
   std::int64_t period_ns = 0;
   int cpu = 0;  // the CPU it runs on (pinned by the file or assigned)
   TaskStatsSnapshot stats;
-  std::string last_error;  // the last method failure, "" if none
+  std::string last_error;          // the last method failure, "" if none
+  std::int64_t last_error_ns = 0;  // when it happened, on the subsystem's clock
+  /// How the task left the ERROR that its last error put it in, if it has: the operator's
+  /// `clear` (or a `kill`), and when. Empty while that error is current, or if it never put the
+  /// task in ERROR (a failure error() recovered, an init that failed).
+  std::optional<Signal> error_ended_by;
+  std::int64_t error_ended_ns = 0;
 };
 
 class Subsystem {
@@ -108,6 +114,11 @@ class Subsystem {
   std::vector<Event> drain_events();
   /// Whether any hard task ended up in ERROR during the run.
   [[nodiscard]] bool hard_task_failed() const;
+  /// Why the run has not been clean, one line each in task order ("" none): every hard task that
+  /// entered ERROR (with its last error), and every task whose module reported a fault as it was
+  /// killed (a resource not released cleanly: a data logger's lost rows). `chimera run` exits 1
+  /// on any. Not real-time safe.
+  [[nodiscard]] std::vector<std::string> faults() const;
 
  private:
   friend class SubsystemTestAccess;  // tests: the table itself (src/control/subsystem_test_access.hpp)

@@ -10,7 +10,10 @@
 
 namespace chimera {
 
-/// Columns task, module, state, period, cycles, missed (and the last error when a task has one).
+/// Columns task, module, state, period, cycles, missed (and the last error when a task has one:
+/// as it is while the task is in that ERROR; "cleared at 1.400 s, was: ..." once an operator's
+/// clear or a kill ended it; "past, at 1.250 s: ..." for one that never put the task in ERROR
+/// or that an earlier state change left behind).
 /// Lines end in '\n'. Not real-time safe.
 std::string status_table(std::span<const TaskSnapshot> tasks);
 /// Columns task, module, state, period, cycles, missed, exec mean/max, latency p50/p99/max; an

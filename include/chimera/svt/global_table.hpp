@@ -32,10 +32,17 @@ struct ReadOutcome {
 
 class GlobalTable {
  public:
-  /// Creates the region /chimera_<name> (mode 0600) and lays out `vars`. The returned owner
-  /// unlinks the region when destroyed. A stale region left by a dead process of the same
-  /// name is replaced. Not real-time safe.
+  /// Creates the region /chimera_<name> (mode 0600) and lays out `vars`, its memory reserved up
+  /// front: a full /dev/shm is an error saying so, never a SIGBUS later. The returned owner
+  /// holds a lock on the region while it lives and unlinks it when destroyed. A region of the
+  /// same name whose lock nobody holds is stale (its creator is gone, however it ended and
+  /// whatever became of its pid) and is replaced; one whose owner lives is refused. Not
+  /// real-time safe.
   static Result<GlobalTable> create(std::string_view subsystem_name, std::span<const VarSpec> vars);
+  /// Removes the name of every region this process created and still owns, each only if the name
+  /// is still that region's: for a signal handler about to end the process the abrupt way, so
+  /// that no region is left behind. The mappings stay valid. Async-signal-safe.
+  static void remove_owned_names_now() noexcept;
   /// Maps an existing region read-write, e.g. from another process. A region of another layout
   /// (detail/shm_layout.hpp's fingerprint differs: another version of Chimera made it) is refused
   /// with a message saying so. Not real-time safe.
@@ -107,6 +114,8 @@ class GlobalTable {
   std::vector<svt_detail::BlockRef> blocks_;
   std::size_t mapped_bytes_ = 0;
   bool owner_ = false;
+  int lock_fd_ = -1;     // the creator's: the region's file, holding the owner's lock while open
+  int owned_note_ = -1;  // the creator's slot for remove_owned_names_now()
 };
 
 /// Holds the illegal-configuration flag of `table` raised while it lives: one raise, one lower.

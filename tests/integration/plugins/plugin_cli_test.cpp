@@ -3,6 +3,7 @@
 
 #include <unistd.h>
 
+#include <filesystem>
 #include <string>
 #include <utility>
 #include <vector>
@@ -91,7 +92,7 @@ TEST_F(PluginCliTest, ALibraryBuiltForAnotherAbiIsOneMessageAndExit2NotACrash) {
   // A C++ library built against a stale module.hpp, and a C library whose struct lacks a field:
   // both loaded, verified and then crashed before; now they are refused at load, naming why.
   const std::vector<std::pair<std::string, std::string>> cases{
-      {"libchimera_test_stale_cxx.so", "rebuild the library against this version"},
+      {"libchimera_test_c_other_abi.so", "a C module was built for C ABI version 43"},
       {"libchimera_test_c_lacks_state_size.so", "its state_size is "}};
   for (const auto& [lib, why] : cases) {
     const std::string f = file("stale.yaml", "plugins: [" + lib + "]\ntasks: []\n");
@@ -131,10 +132,122 @@ TEST_F(PluginCliTest, ModulesLoadsAPluginGivenOnTheCommandLine) {
   EXPECT_TRUE(contains(refused.err, "registers no modules")) << refused.err;
 }
 
-TEST_F(PluginCliTest, ModulesReportsABrokenLibraryOnThePath) {
+TEST_F(PluginCliTest, ModulesListsWhatLoadsAndNamesEachBrokenLibraryOnThePath) {
+  // bad/ holds a library of every flaw: none may hide the built-in modules or the good libraries.
   const auto o = chimera("modules", {}, kGood + ":" + kBad);
+  EXPECT_EXIT_CODE(o, 2);  // the answer is not whole, and says so
+  for (const char* line : {"pid_joint ", "data_logger ", "my_module ", "test_c_counter "})
+    EXPECT_TRUE(contains(o.out, line)) << line << "\n" << o.out;
+  EXPECT_TRUE(contains(o.out, kGood + "/libchimera_test_template.so")) << o.out;
+  // What a refused library brought leaves with it.
+  EXPECT_FALSE(contains(o.out, "test_companion")) << o.out;
+  EXPECT_FALSE(contains(o.out, "test_flawed")) << o.out;
+  // One line each, naming the library and its flaw, then a closing line with the count.
+  const std::vector<std::pair<std::string, std::string>> named{
+      {"libchimera_test_no_modules.so", "registers no modules"},
+      {"libchimera_test_undefined_symbol.so", "cannot load 'libchimera_test_undefined_symbol.so': "},
+      {"libchimera_test_duplicate.so", "module 'my_module' is registered twice (the first comes from " + kGood},
+      {"libchimera_test_c_other_abi.so", "a C module was built for C ABI version 43"},
+      {"libchimera_test_bad_name.so", "port 'theta d' is not a valid name"},
+  };
+  for (const auto& [lib, why] : named) {
+    const auto at = o.err.find("CHIMERA_MODULE_PATH: '" + lib + "' (" + kBad + "/" + lib + "): ");
+    const auto line = at == std::string::npos ? o.err.find("CHIMERA_MODULE_PATH: cannot load '" + lib + "'") : at;
+    ASSERT_NE(line, std::string::npos) << lib << "\n" << o.err;
+    EXPECT_TRUE(contains(o.err.substr(line, o.err.find('\n', line) - line), why)) << lib << "\n" << o.err;
+  }
+  std::size_t lines = 0;
+  for (char c : o.err) lines += c == '\n' ? 1 : 0;
+  const std::string last = o.err.substr(o.err.rfind('\n', o.err.size() - 2) + 1);
+  EXPECT_EQ(last, "chimera modules: " + std::to_string(lines - 1) +
+                      " module libraries did not load (named above); their modules are missing from what is shown\n")
+      << o.err;
+
+  // One module of a good library: shown, with the broken ones named all the same.
+  const auto one = chimera("modules my_module", {}, kGood + ":" + kBad);
+  EXPECT_EXIT_CODE(one, 2);
+  EXPECT_TRUE(contains(one.out, "my_module: y = k u, channel by channel")) << one.out;
+  EXPECT_TRUE(contains(one.err, "libchimera_test_no_modules.so")) << one.err;
+}
+
+TEST_F(PluginCliTest, ADuplicateLibraryOnThePathIsNamedAndTheFirstCopyListed) {
+  const std::string copies = dir_.file("copies");
+  std::filesystem::create_directories(copies);
+  std::filesystem::copy_file(kGood + "/libchimera_test_template.so", copies + "/libchimera_test_template.so");
+  const auto o = chimera("modules", {}, kGood + ":" + copies);
   EXPECT_EXIT_CODE(o, 2);
-  EXPECT_TRUE(o.err.starts_with("CHIMERA_MODULE_PATH: ")) << o.err;
+  EXPECT_TRUE(contains(o.out, kGood + "/libchimera_test_template.so")) << o.out;
+  EXPECT_TRUE(contains(o.out, "test_c_counter ")) << o.out;
+  EXPECT_TRUE(o.err.starts_with("CHIMERA_MODULE_PATH: 'libchimera_test_template.so' (" + copies +
+                                "/libchimera_test_template.so): module 'my_module' is registered twice (the first "
+                                "comes from " +
+                                kGood + "/libchimera_test_template.so)\n"))
+      << o.err;
+}
+
+TEST_F(PluginCliTest, ABrokenLibraryOnThePathDoesNotStopAFileThatDoesNotUseIt) {
+  // Run and verify load only the libraries the file names: a broken one elsewhere on the path is
+  // not theirs to refuse.
+  const std::string f = file("good.yaml", kTwoPlugins);
+  const std::string path = kBad + ":" + kGood;
+  EXPECT_EXIT_CODE(chimera("verify " + quoted(f), {}, path), 0);
+  const auto run = chimera("run " + quoted(f) + " --clock virtual --for 100ms", "get count\n", path);
+  EXPECT_EXIT_CODE(run, 0);
+  EXPECT_TRUE(contains(run.out, "count = [")) << run.out;
+  // A file that names a broken library is refused, naming the file, line, key and library.
+  const std::string g =
+      file("bad.yaml", "plugins: [libchimera_test_template.so, libchimera_test_no_modules.so]\ntasks: []\n");
+  const auto refused = chimera("verify " + quoted(g), {}, path);
+  EXPECT_EXIT_CODE(refused, 2);
+  EXPECT_TRUE(refused.err.starts_with(g + ":2: plugins[1]: 'libchimera_test_no_modules.so' (" + kBad +
+                                      "/libchimera_test_no_modules.so): registers no modules"))
+      << refused.err;
+}
+
+// A hard task (the C counter, failing at its third cycle) in a scripted run: its events on stderr
+// and never among the replies, status telling its past error from its present state, and the
+// run's exit 1 explained in its last line.
+TEST_F(PluginCliTest, EventsGoToStderrStatusTellsAPastErrorAndExit1SaysWhy) {
+  const std::string f = file("failing.yaml",
+                             "plugins: [chimera_test_c_counter]\n"
+                             "constants: { tick: [0] }\n"
+                             "tasks:\n"
+                             "  - name: counter\n"
+                             "    module: test_c_counter\n"
+                             "    period: 10ms\n"
+                             "    rename: { u: tick }\n"
+                             "    params: { fail_at: 3 }\n");
+  const auto o = chimera("run " + quoted(f) + " --clock virtual --for 1s",
+                         "wait 50ms\nstatus\nclear counter\non counter\nstatus\nquit\n");
+  EXPECT_EXIT_CODE(o, 1);
+  // The events: on stderr, not among the replies.
+  EXPECT_TRUE(contains(o.err, "counter: cycle failed: counter failed on purpose\n")) << o.err;
+  EXPECT_TRUE(contains(o.err, "counter: ERROR: operator intervention required (clear): counter failed on purpose\n"))
+      << o.err;
+  EXPECT_FALSE(contains(o.out, "counter: cycle failed")) << o.out;
+  // The replies: the first status shows the error as the task's state, the second (after clear
+  // and on) shows the task ON and the error as past, cleared at 50 ms.
+  const auto first = o.out.find("last error");
+  ASSERT_NE(first, std::string::npos) << o.out;
+  const auto second = o.out.find("last error", first + 1);
+  ASSERT_NE(second, std::string::npos) << o.out;
+  const std::string before = o.out.substr(first, second - first);
+  const std::string after = o.out.substr(second);
+  EXPECT_TRUE(contains(before, " ERROR ")) << before;
+  EXPECT_TRUE(contains(before, "  ERROR: operator intervention required (clear): counter failed on purpose\n"))
+      << before;
+  EXPECT_TRUE(contains(after, " ON ")) << after;
+  EXPECT_TRUE(contains(after,
+                       "cleared at 0.050 s, was: ERROR: operator intervention required (clear): counter failed on "
+                       "purpose\n"))
+      << after;
+  EXPECT_TRUE(contains(o.out, "counter: OFF\ncounter: ON\n")) << o.out;
+  // The last line of the run says why it exits 1.
+  const std::string last = o.err.substr(o.err.rfind('\n', o.err.size() - 2) + 1);
+  EXPECT_EQ(last,
+            "chimera: exit 1: hard task counter entered ERROR (ERROR: operator intervention required (clear): counter "
+            "failed on purpose)\n")
+      << o.err;
 }
 
 }  // namespace

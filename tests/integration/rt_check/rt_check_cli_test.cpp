@@ -72,10 +72,10 @@ TEST_F(RtCheckCliTest, CountsEveryAllocatingCycleAndOnlyThose) {
   EXPECT_GE(hoarder.at("rt_violations").get<std::uint64_t>(), cycles);
   EXPECT_GT(doc.at("tasks").at("quiet").at("cycles").get<std::uint64_t>(), 0U);
   EXPECT_EQ(doc.at("tasks").at("quiet").at("rt_violations").get<std::uint64_t>(), 0U);
-  // One event for the operator, however many cycles allocated.
-  const auto first = o.out.find(kEvent);
-  EXPECT_NE(first, std::string::npos) << o.out;
-  EXPECT_EQ(o.out.find(kEvent, first + 1), std::string::npos) << o.out;
+  // One event for the operator (on stderr, with the other events), however many cycles allocated.
+  const auto first = o.err.find(kEvent);
+  EXPECT_NE(first, std::string::npos) << o.err;
+  EXPECT_EQ(o.err.find(kEvent, first + 1), std::string::npos) << o.err;
   EXPECT_TRUE(contains(o.out, "rt violations")) << o.out;
 }
 
@@ -83,7 +83,7 @@ TEST_F(RtCheckCliTest, WithoutTheFlagNothingIsCountedOrShown) {
   const auto o = chimera("run " + quoted(two_tasks_file()) + " --clock virtual --for 1s" + stats_arg());
   EXPECT_EXIT_CODE(o, 0);
   EXPECT_FALSE(contains(o.out, "rt violations")) << o.out;
-  EXPECT_FALSE(contains(o.out, "allocated on the real-time path")) << o.out;
+  EXPECT_FALSE(contains(o.err, "allocated on the real-time path")) << o.err;
   const auto doc = stats();
   EXPECT_FALSE(doc.at("rt_check").get<bool>());
   EXPECT_EQ(doc.at("tasks").at("hoarder").at("rt_violations").get<std::uint64_t>(), 0U);
@@ -93,7 +93,7 @@ TEST_F(RtCheckCliTest, FigureFourAllocatesNothingOnTheRealTimePath) {
   const auto o = chimera("run " + quoted(fig4_file()) + " --clock virtual --for 1s --rt-check" + stats_arg());
   EXPECT_EXIT_CODE(o, 0);
   EXPECT_TRUE(contains(o.out, "rt violations")) << o.out;
-  EXPECT_FALSE(contains(o.out, "allocated on the real-time path")) << o.out;
+  EXPECT_FALSE(contains(o.err, "allocated on the real-time path")) << o.err;
   const auto doc = stats();
   ASSERT_FALSE(doc.at("tasks").empty());
   for (const auto& [name, task] : doc.at("tasks").items()) {

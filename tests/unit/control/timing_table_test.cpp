@@ -70,6 +70,34 @@ TEST(StatusTable, ShowsTheLastErrorWhenThereIsOne) {
   EXPECT_NE(text.find("joint limit"), std::string::npos);
 }
 
+TEST(StatusTable, TellsAPastErrorFromTheCurrentState) {
+  auto tasks = sample();
+  tasks[0].last_error = "ERROR: operator intervention required (clear): joint limit";
+  tasks[0].last_error_ns = 1'250'000'000;
+  tasks[0].state = TaskState::kError;
+  EXPECT_NE(status_table(tasks).find("  ERROR: operator intervention required (clear): joint limit\n"),
+            std::string::npos)
+      << status_table(tasks);
+
+  // After clear and on: the state says ON, and the error says it was cleared, and when.
+  tasks[0].state = TaskState::kOn;
+  tasks[0].error_ended_by = Signal::kClear;
+  tasks[0].error_ended_ns = 1'400'000'000;
+  const auto cleared = status_table(tasks);
+  EXPECT_NE(cleared.find("cleared at 1.400 s, was: ERROR: operator intervention required (clear): joint limit\n"),
+            std::string::npos)
+      << cleared;
+
+  tasks[0].error_ended_by = Signal::kKill;
+  EXPECT_NE(status_table(tasks).find("killed at 1.400 s, was: "), std::string::npos) << status_table(tasks);
+
+  // A failure that error() recovered from never was the task's state.
+  tasks[0].error_ended_by.reset();
+  tasks[0].last_error = "cycle failed: joint limit";
+  EXPECT_NE(status_table(tasks).find("past, at 1.250 s: cycle failed: joint limit\n"), std::string::npos)
+      << status_table(tasks);
+}
+
 TEST(TimingTable, HumanUnitsAndDashesForTasksThatNeverRan) {
   const auto lines = lines_of(timing_table(sample()));
   ASSERT_EQ(lines.size(), 3U);

@@ -195,6 +195,52 @@ TEST(GlobalTableLifetime, StaleRegionOfADeadProcessIsReplaced) {
   EXPECT_EQ(d::object_at<d::Header>(raw.base(), 0)->owner_pid, static_cast<std::uint64_t>(::getpid()));
 }
 
+TEST(GlobalTableLifetime, AStaleRegionIsReplacedWhateverBecameOfItsPid) {
+  // Liveness is the creator's lock, not its pid: a dead creator's region is stale even when its
+  // pid now belongs to a live process (this one, or init).
+  for (const pid_t recorded : {::getpid(), pid_t{1}}) {
+    const auto name = unique_subsystem("reused");
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      auto table = GlobalTable::create(name, fig4_vars());
+      ::_exit(table ? 0 : 1);  // no destructor: the region stays, its lock goes with the process
+    }
+    int status = 0;
+    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+    {
+      RawMapping raw(name);
+      ASSERT_NE(raw.base(), nullptr);
+      d::object_at<d::Header>(raw.base(), 0)->owner_pid = static_cast<std::uint64_t>(recorded);
+    }
+    auto table = GlobalTable::create(name, fig4_vars());
+    ASSERT_TRUE(table) << "pid " << recorded << ": " << table.error().message;
+    RawMapping raw(name);
+    EXPECT_EQ(d::object_at<d::Header>(raw.base(), 0)->owner_pid, static_cast<std::uint64_t>(::getpid()));
+  }
+}
+
+TEST(GlobalTableLifetime, TheSignalTimeRemovalTakesOnlyThisProcesssOwnNames) {
+  const auto name = unique_subsystem("abrupt");
+  auto old_owner = GlobalTable::create(name, fig4_vars());
+  ASSERT_TRUE(old_owner) << old_owner.error().message;
+  GlobalTable::remove_owned_names_now();
+  EXPECT_FALSE(exists(dev_shm_path(name)));
+  // The mapping stays usable; the name is free for a new region, which the old owner's release
+  // must then leave alone.
+  const std::vector<std::byte> value(old_owner->shape(0).bytes(), std::byte{1});
+  old_owner->write(0, value.data());
+  EXPECT_EQ(old_owner->version(0), 1U);
+  {
+    auto newer = GlobalTable::create(name, fig4_vars());
+    ASSERT_TRUE(newer) << newer.error().message;
+    *old_owner = GlobalTable::create(unique_subsystem("other"), fig4_vars()).value();  // releases the old region
+    EXPECT_TRUE(exists(dev_shm_path(name))) << "the old owner removed the newer region's name";
+  }
+  EXPECT_FALSE(exists(dev_shm_path(name)));
+}
+
 TEST(GlobalTableLifetime, RegionWithoutOwnerIsReplacedAfterAWait) {
   // A creator that died between shm_open and storing its pid leaves a region of zeros.
   const auto name = unique_subsystem("ownerless");

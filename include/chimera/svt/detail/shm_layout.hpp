@@ -38,8 +38,10 @@ inline constexpr std::size_t kCacheLine = 64;
 inline constexpr std::uint64_t kMagic = 0x315456534d494843ULL;
 inline constexpr std::size_t kNameCapacity = 64;  // including the terminating NUL
 /// Bumped by hand when the meaning of a word changes without its size or place (the flag became
-/// a count of raisers in revision 2); every size, offset and constant is in the fingerprint anyway.
-inline constexpr std::uint64_t kLayoutRevision = 2;
+/// a count of raisers in revision 2; in 3 the creator holds an flock on the region while it
+/// lives, and the owner pid is for messages only); every size, offset and constant is in the
+/// fingerprint anyway.
+inline constexpr std::uint64_t kLayoutRevision = 3;
 
 // Atomics in the region must be lock-free: a lock-based atomic_ref would keep its lock in this
 // process's memory, invisible to the other processes mapping the region.
@@ -51,7 +53,7 @@ struct Header {
   std::uint64_t magic;
   std::uint32_t layout_version;
   std::uint32_t var_count;
-  std::uint64_t owner_pid;  // atomic: a starting process may read it while the owner creates
+  std::uint64_t owner_pid;  // the creator's, for messages; liveness is its flock (region_ownership.hpp)
   std::uint64_t directory_offset;
   std::uint64_t total_size;
   std::uint64_t layout_fingerprint;  // kLayoutFingerprint of the creator
