@@ -139,80 +139,119 @@ std::vector<Unit> units_of(std::span<const TaskModel> tasks, const AnalysisOptio
   return units;
 }
 
-}  // namespace
-
-std::vector<int> assign_cpus(std::span<const TaskModel> tasks, std::span<const int> cpus, SchedulerKind scheduler,
-                             const AnalysisOptions& options) {
-  std::vector<int> cpu_of(tasks.size(), -1);
-  std::vector<Cpu> state;
-  for (const int c : cpus) state.push_back(Cpu{c, {}, 0.0, 0});
-  std::sort(state.begin(), state.end(), [](const Cpu& a, const Cpu& b) { return a.number < b.number; });
-  const auto find = [&](int number) {
-    return std::find_if(state.begin(), state.end(), [&](const Cpu& c) { return c.number == number; });
-  };
-  const auto place = [&](std::size_t i, Cpu& cpu) {
-    cpu_of[i] = cpu.number;
-    if (demand_of(tasks[i], options)) {
-      cpu.known.push_back(tasks[i]);
-      cpu.load += share(tasks[i], options);
-    } else {
-      ++cpu.unknown;
-    }
-  };
-
-  for (std::size_t i = 0; i < tasks.size(); ++i) {
-    if (tasks[i].cpu < 0) continue;
-    cpu_of[i] = tasks[i].cpu;
-    if (auto at = find(tasks[i].cpu); at != state.end()) place(i, *at);
+// One assignment in progress: the CPUs with what is on them so far, and each task's CPU.
+class Placement {
+ public:
+  Placement(std::span<const TaskModel> tasks, std::span<const int> cpus, SchedulerKind scheduler,
+            const AnalysisOptions& options)
+      : tasks_(tasks), scheduler_(scheduler), options_(options), cpu_of_(tasks.size(), -1) {
+    for (const int c : cpus) state_.push_back(Cpu{c, {}, 0.0, 0});
+    std::sort(state_.begin(), state_.end(), [](const Cpu& a, const Cpu& b) { return a.number < b.number; });
   }
-  if (state.empty()) return cpu_of;
 
-  std::vector<Unit> known;
-  std::vector<Unit> unknown;
-  for (auto& u : units_of(tasks, options)) (u.known ? known : unknown).push_back(std::move(u));
+  [[nodiscard]] bool no_cpus() const { return state_.empty(); }
+  [[nodiscard]] std::vector<int> result() && { return std::move(cpu_of_); }
 
-  // Worst fit decreasing by the unit's utilisation: the least-loaded CPU on which the unit fits
-  // whole, the CPU of its pinned tasks first. A chain that fits nowhere whole is split, task by task.
-  std::stable_sort(known.begin(), known.end(), [](const Unit& a, const Unit& b) {
-    if (a.share != b.share) return a.share > b.share;
-    if (a.period_ns != b.period_ns) return a.period_ns < b.period_ns;
-    return a.first < b.first;
-  });
-  const auto by_load = [&](int preferred) {
-    std::vector<Cpu*> order;
-    order.reserve(state.size());
-    for (auto& c : state) order.push_back(&c);
-    std::stable_sort(order.begin(), order.end(), [&](const Cpu* a, const Cpu* b) {
-      if ((a->number == preferred) != (b->number == preferred)) return a->number == preferred;
-      return a->load < b->load;
-    });
-    return order;
-  };
-  for (const Unit& unit : known) {
+  void place_pinned() {
+    for (std::size_t i = 0; i < tasks_.size(); ++i) {
+      if (tasks_[i].cpu < 0) continue;
+      cpu_of_[i] = tasks_[i].cpu;
+      if (Cpu* at = find(tasks_[i].cpu)) place(i, *at);
+    }
+  }
+
+  // Worst fit: the least-loaded CPU on which the unit fits whole, the CPU of its pinned tasks
+  // first. A chain that fits nowhere whole is split, task by task, largest first.
+  void place_known(const Unit& unit) {
     std::vector<TaskModel> members;
-    for (const std::size_t i : unit.members) members.push_back(tasks[i]);
+    for (const std::size_t i : unit.members) members.push_back(tasks_[i]);
     const auto candidates = by_load(unit.pinned_cpu);
     const auto whole = std::find_if(candidates.begin(), candidates.end(),
-                                    [&](const Cpu* c) { return fits(*c, members, scheduler, options); });
+                                    [&](const Cpu* c) { return fits(*c, members, scheduler_, options_); });
     if (whole != candidates.end()) {
       for (const std::size_t i : unit.members) place(i, **whole);
-      continue;
+      return;
     }
-    std::vector<std::size_t> split = unit.members;  // largest first, as the units are
-    std::stable_sort(split.begin(), split.end(),
-                     [&](std::size_t a, std::size_t b) { return share(tasks[a], options) > share(tasks[b], options); });
+    std::vector<std::size_t> split = unit.members;
+    std::stable_sort(split.begin(), split.end(), [&](std::size_t a, std::size_t b) {
+      return share(tasks_[a], options_) > share(tasks_[b], options_);
+    });
     for (const std::size_t i : split) {
       const auto one = by_load(-1);
       const auto feasible = std::find_if(one.begin(), one.end(), [&](const Cpu* c) {
-        return fits(*c, std::span<const TaskModel>(&tasks[i], 1), scheduler, options);
+        return fits(*c, std::span<const TaskModel>(&tasks_[i], 1), scheduler_, options_);
       });
       place(i, feasible != one.end() ? **feasible : *one.front());
     }
   }
 
-  // Units of unknown share: periodic before background, by period, then file order; each whole on
-  // the CPU of its pinned tasks, else the one with the fewest such tasks, then the lowest load,
-  // then the lower number: spread evenly, never all on one CPU.
+  // A unit of unknown share goes whole on the CPU of its pinned tasks, else on the one with the
+  // fewest such tasks, then the lowest load, then the lower number.
+  void place_unknown(const Unit& unit) {
+    Cpu* target = find(unit.pinned_cpu);
+    if (target == nullptr)
+      target = &*std::min_element(state_.begin(), state_.end(), [](const Cpu& a, const Cpu& b) {
+        if (a.unknown != b.unknown) return a.unknown < b.unknown;
+        return a.load < b.load;  // min_element keeps the first (lower number) on a tie
+      });
+    for (const std::size_t i : unit.members) place(i, *target);
+  }
+
+ private:
+  Cpu* find(int number) {
+    const auto at = std::find_if(state_.begin(), state_.end(), [&](const Cpu& c) { return c.number == number; });
+    return at == state_.end() ? nullptr : &*at;
+  }
+
+  void place(std::size_t i, Cpu& cpu) {
+    cpu_of_[i] = cpu.number;
+    if (demand_of(tasks_[i], options_)) {
+      cpu.known.push_back(tasks_[i]);
+      cpu.load += share(tasks_[i], options_);
+    } else {
+      ++cpu.unknown;
+    }
+  }
+
+  // The CPUs from the least loaded (ties: lower number), `preferred` first.
+  std::vector<Cpu*> by_load(int preferred) {
+    std::vector<Cpu*> order;
+    order.reserve(state_.size());
+    for (auto& c : state_) order.push_back(&c);
+    std::stable_sort(order.begin(), order.end(), [&](const Cpu* a, const Cpu* b) {
+      if ((a->number == preferred) != (b->number == preferred)) return a->number == preferred;
+      return a->load < b->load;
+    });
+    return order;
+  }
+
+  std::span<const TaskModel> tasks_;
+  SchedulerKind scheduler_;
+  const AnalysisOptions& options_;
+  std::vector<Cpu> state_;
+  std::vector<int> cpu_of_;
+};
+
+}  // namespace
+
+std::vector<int> assign_cpus(std::span<const TaskModel> tasks, std::span<const int> cpus, SchedulerKind scheduler,
+                             const AnalysisOptions& options) {
+  Placement placement(tasks, cpus, scheduler, options);
+  placement.place_pinned();
+  if (placement.no_cpus()) return std::move(placement).result();
+
+  std::vector<Unit> known;
+  std::vector<Unit> unknown;
+  for (auto& u : units_of(tasks, options)) (u.known ? known : unknown).push_back(std::move(u));
+  // Worst fit decreasing by the unit's utilisation (ties: shorter period, then file order).
+  std::stable_sort(known.begin(), known.end(), [](const Unit& a, const Unit& b) {
+    if (a.share != b.share) return a.share > b.share;
+    if (a.period_ns != b.period_ns) return a.period_ns < b.period_ns;
+    return a.first < b.first;
+  });
+  for (const Unit& unit : known) placement.place_known(unit);
+  // Then the units of unknown share: periodic before background, by period, then file order:
+  // spread evenly, never all on one CPU.
   std::stable_sort(unknown.begin(), unknown.end(), [](const Unit& a, const Unit& b) {
     const bool ba = a.period_ns <= 0;
     const bool bb = b.period_ns <= 0;
@@ -220,16 +259,8 @@ std::vector<int> assign_cpus(std::span<const TaskModel> tasks, std::span<const i
     if (a.period_ns != b.period_ns) return a.period_ns < b.period_ns;
     return a.first < b.first;
   });
-  for (const Unit& unit : unknown) {
-    auto target = find(unit.pinned_cpu);
-    if (target == state.end())
-      target = std::min_element(state.begin(), state.end(), [](const Cpu& a, const Cpu& b) {
-        if (a.unknown != b.unknown) return a.unknown < b.unknown;
-        return a.load < b.load;  // min_element keeps the first (lower number) on a tie
-      });
-    for (const std::size_t i : unit.members) place(i, *target);
-  }
-  return cpu_of;
+  for (const Unit& unit : unknown) placement.place_unknown(unit);
+  return std::move(placement).result();
 }
 
 std::vector<int> assign_subsystem_cpus(const SubsystemSpec& spec, const ReleaseOrder& order, std::span<const int> cpus,

@@ -391,6 +391,42 @@ CrossCpuWait cross_cpu_wait(std::span<const TaskModel> tasks, std::span<const in
 
 }  // namespace
 
+namespace {
+
+// What the waits do to one verdict: say how long a task that meets may wait, refuse a bound to a
+// task that waits for an unbounded producer (or whose waits did not settle).
+void apply_wait(const TaskModel& task, const CrossCpuWait& wait, std::int64_t jitter_ns, bool settled, TaskResult& r) {
+  r.release_jitter_ns = jitter_ns;
+  // A run waits at most half the deadline (release_policy::producer_wait_until), then goes on with
+  // the producer's previous value: the time is kept, the same-rate order is not. Analysis counts
+  // the whole wait, on the safe side, and says where the two part.
+  if (r.verdict == Verdict::kCanMiss && jitter_ns > 0 && 2 * jitter_ns > relative_deadline(task) &&
+      !wait.longest.empty())
+    r.reason += fmt::format(
+        "; it waits up to {} for {} on another CPU, past half its deadline, where a run stops waiting and "
+        "reads {}'s previous value (an order timeout): keep the chain on one CPU",
+        exact_duration_text(jitter_ns), wait.longest, wait.longest);
+  if (r.verdict != Verdict::kMeets || (jitter_ns == 0 && wait.unbounded.empty())) return;
+  if (!wait.unbounded.empty() || !settled) {
+    r.verdict = Verdict::kCanMiss;
+    r.response_ns = 0;
+    r.response_is_bound = false;
+    r.reason =
+        !wait.unbounded.empty()
+            ? fmt::format("cannot be bounded: {} for {} on another CPU, which has no bound",
+                          wait.behind.empty() ? "it waits" : wait.behind + ", on its thread, waits", wait.unbounded)
+            : std::string("cannot be bounded: the waits for producers on other CPUs did not settle");
+  } else if (wait.behind.empty()) {
+    r.reason =
+        fmt::format("after waiting up to {} for {} on another CPU", exact_duration_text(jitter_ns), wait.longest);
+  } else {
+    r.reason = fmt::format("after waiting up to {} behind {}, on its thread, which waits for {} on another CPU",
+                           exact_duration_text(jitter_ns), wait.behind, wait.longest);
+  }
+}
+
+}  // namespace
+
 ConfigurationResult analyse_configuration(std::span<const TaskModel> tasks, std::span<const int> cpu_of,
                                           std::span<const int> cpus, SchedulerKind scheduler,
                                           const AnalysisOptions& options) {
@@ -412,52 +448,21 @@ ConfigurationResult analyse_configuration(std::span<const TaskModel> tasks, std:
   const std::size_t max_rounds = 2 * tasks.size() + 4;
   bool settled = false;
   for (std::size_t round = 0; round < max_rounds && !settled; ++round) {
-    settled = true;
     for (std::size_t i = 0; i < tasks.size(); ++i) waits[i] = cross_cpu_wait(jittered, cpu_of, position, i, result);
     share_waits_within_threads(jittered, cpu_of, scheduler, waits);
+    settled = true;
     for (std::size_t i = 0; i < tasks.size(); ++i) {
-      if (waits[i].jitter_ns > jittered[i].release_jitter_ns) {
-        jittered[i].release_jitter_ns = waits[i].jitter_ns;
-        settled = false;
-      }
+      if (waits[i].jitter_ns <= jittered[i].release_jitter_ns) continue;
+      jittered[i].release_jitter_ns = waits[i].jitter_ns;
+      settled = false;
     }
     if (!settled) result = analyse_cpus(jittered, cpu_of, cpus, scheduler, options);
   }
 
-  // What the waits do to the verdicts: say how long a task that meets may wait, and refuse a bound
-  // to a task that waits for an unbounded producer.
   result.feasible = true;
   for (auto& cpu : result.cpus) {
-    for (auto& r : cpu.tasks) {
-      const CrossCpuWait& wait = waits[r.index];
-      r.release_jitter_ns = jittered[r.index].release_jitter_ns;
-      // A run waits at most half the deadline (release_policy::producer_wait_until), then goes on
-      // with the producer's previous value: the time is kept, the same-rate order is not. Analysis
-      // counts the whole wait, on the safe side, and says where the two part.
-      if (r.verdict == Verdict::kCanMiss && r.release_jitter_ns > 0 &&
-          2 * r.release_jitter_ns > relative_deadline(tasks[r.index]) && !wait.longest.empty())
-        r.reason += fmt::format(
-            "; it waits up to {} for {} on another CPU, past half its deadline, where a run stops waiting and "
-            "reads {}'s previous value (an order timeout): keep the chain on one CPU",
-            exact_duration_text(r.release_jitter_ns), wait.longest, wait.longest);
-      if (r.verdict != Verdict::kMeets) continue;
-      if (!wait.unbounded.empty() || (!settled && r.release_jitter_ns > 0)) {
-        r.verdict = Verdict::kCanMiss;
-        r.response_ns = 0;
-        r.response_is_bound = false;
-        r.reason =
-            !wait.unbounded.empty()
-                ? fmt::format("cannot be bounded: {} for {} on another CPU, which has no bound",
-                              wait.behind.empty() ? "it waits" : wait.behind + ", on its thread, waits", wait.unbounded)
-                : std::string("cannot be bounded: the waits for producers on other CPUs did not settle");
-      } else if (r.release_jitter_ns > 0 && wait.behind.empty()) {
-        r.reason = fmt::format("after waiting up to {} for {} on another CPU", exact_duration_text(r.release_jitter_ns),
-                               wait.longest);
-      } else if (r.release_jitter_ns > 0) {
-        r.reason = fmt::format("after waiting up to {} behind {}, on its thread, which waits for {} on another CPU",
-                               exact_duration_text(r.release_jitter_ns), wait.behind, wait.longest);
-      }
-    }
+    for (auto& r : cpu.tasks)
+      apply_wait(tasks[r.index], waits[r.index], jittered[r.index].release_jitter_ns, settled, r);
     // A task that can miss makes its CPU infeasible; under muf only critical tasks can (the others
     // are promised nothing), so the rule is the same for every scheduler.
     cpu.feasible = cpu.feasible && std::none_of(cpu.tasks.begin(), cpu.tasks.end(),

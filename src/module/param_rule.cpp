@@ -1,5 +1,6 @@
 #include "chimera/module/param_rule.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -33,10 +34,7 @@ bool in_range(const ParamRule& rule, double x) {
 }
 
 bool chosen(const ParamRule& rule, const std::string& text) {
-  if (rule.choices.empty()) return true;
-  for (const auto& c : rule.choices)
-    if (c == text) return true;
-  return false;
+  return rule.choices.empty() || std::ranges::any_of(rule.choices, [&](const std::string& c) { return c == text; });
 }
 
 std::string choices_text(const ParamRule& rule) { return fmt::format("one of: {}", fmt::join(rule.choices, ", ")); }

@@ -50,7 +50,7 @@ struct TaskModel {
   int chain = -1;
   /// The file indices of the same-period tasks whose job of the same release this task waits for
   /// before it starts (the same-rate rule). On another CPU, that wait is the task's release jitter.
-  std::vector<int> same_rate_producers;
+  std::vector<int> same_rate_producers{};
   /// Release jitter: how long after its release the task may wait for those producers when they
   /// run on another CPU. analyse_configuration() finds it from their response times.
   std::int64_t release_jitter_ns = 0;

@@ -47,7 +47,7 @@ struct ParamDecl {
   ParamValue default_value;
   std::string unit;  // "rad", "N*m/rad", "" for none
   std::string doc;
-  ParamRule rule;  // the values it accepts beyond its type (none: any)
+  ParamRule rule{};  // the values it accepts beyond its type (none: any)
 };
 
 /// Filled by a module's static declare(Declarations&, const Params&).

@@ -18,12 +18,12 @@
 namespace chimera {
 
 struct ParamRule {
-  std::optional<double> lower;  // a bound below, inclusive unless lower_exclusive
+  std::optional<double> lower{};  // a bound below, inclusive unless lower_exclusive
   bool lower_exclusive = false;
-  std::optional<double> upper;  // a bound above, inclusive unless upper_exclusive
+  std::optional<double> upper{};  // a bound above, inclusive unless upper_exclusive
   bool upper_exclusive = false;
-  bool whole = false;                // numbers only: whole numbers (counts, sizes, ports)
-  std::vector<std::string> choices;  // empty: any text
+  bool whole = false;                  // numbers only: whole numbers (counts, sizes, ports)
+  std::vector<std::string> choices{};  // empty: any text
 
   [[nodiscard]] bool empty() const { return !lower && !upper && !whole && choices.empty(); }
 };
