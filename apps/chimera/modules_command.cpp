@@ -159,11 +159,14 @@ void print_module(const ModuleInfo& m, std::string_view origin) {
     TextTable params({{"  name", Align::kLeft},
                       {"type", Align::kLeft},
                       {"default", Align::kLeft},
+                      {"accepts", Align::kLeft},
                       {"unit", Align::kLeft},
                       {"doc", Align::kLeft}});
-    for (const auto& p : decls.params())
+    for (const auto& p : decls.params()) {
+      const std::string accepts = describe(p.rule);
       params.add_row({fmt::format("  {}", p.name), std::string(param_type_name(p.type)), to_string(p.default_value),
-                      p.unit, p.doc});
+                      accepts.empty() ? "any" : accepts, p.unit, p.doc});
+    }
     fmt::print("{}", params.render());
   }
 }

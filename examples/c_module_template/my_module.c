@@ -17,6 +17,8 @@ static void my_module_declare(chimera_decl* d, const chimera_params* params) {
   chimera_in_var(d, "u", chimera_dim_of("ndof", 1), "input");
   chimera_out_var(d, "y", chimera_dim_of("ndof", 1), "filtered input");
   chimera_param_number(d, "tau", 0.1, "s", "time constant (> 0)");
+  /* What it accepts: chimera verify refuses tau <= 0 with the file's line, before init could. */
+  chimera_param_greater_than(d, "tau", 0.0);
 }
 
 /* init may fail: a string literal says why, and the task is not created. */

@@ -19,7 +19,9 @@ class MyModule final : public chimera::Module {
     d.in_const("ndof", chimera::Dim::fixed(1), "number of channels");
     d.in_var("u", chimera::Dim::of("ndof"), "input");
     d.out_var("y", chimera::Dim::of("ndof"), "output, k u");
-    d.param("k", 2.0, "", "gain");
+    // What a parameter accepts (at_least, greater_than, at_most, less_than, whole, one_of):
+    // `chimera verify` refuses anything else with the file's line, before init could.
+    d.param("k", 2.0, "", "gain").at_least(-100).at_most(100);
   }
 
  protected:

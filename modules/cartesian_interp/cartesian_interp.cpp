@@ -29,10 +29,16 @@ class CartesianInterp final : public Module {
     d.out_var("x_d", Dim::fixed(6), "desired tool pose, m and rad");
     d.out_var("dx_d", Dim::fixed(6), "desired tool velocity [vx vy vz wx wy wz], m/s and rad/s");
     const Limits defaults;
-    d.param("speed", defaults.speed, "m/s", "highest speed of the tool point");
-    d.param("acceleration", defaults.acceleration, "m/s^2", "highest acceleration of the tool point");
-    d.param("angular_speed", defaults.angular_speed, "rad/s", "highest angular speed of the tool");
-    d.param("angular_acceleration", defaults.angular_acceleration, "rad/s^2", "highest angular acceleration");
+    d.param("speed", defaults.speed, "m/s", "highest speed of the tool point").greater_than(0).less_than(1e6);
+    d.param("acceleration", defaults.acceleration, "m/s^2", "highest acceleration of the tool point")
+        .greater_than(0)
+        .less_than(1e6);
+    d.param("angular_speed", defaults.angular_speed, "rad/s", "highest angular speed of the tool")
+        .greater_than(0)
+        .less_than(1e6);
+    d.param("angular_acceleration", defaults.angular_acceleration, "rad/s^2", "highest angular acceleration")
+        .greater_than(0)
+        .less_than(1e6);
   }
 
  protected:

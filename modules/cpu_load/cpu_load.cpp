@@ -27,9 +27,9 @@ class CpuLoad final : public Module {
   static constexpr const char* kDoc = docs::cpu_load::kText;
 
   static void declare(Declarations& d, const Params& /*params*/) {
-    d.param("exec", 0.0, "s", "execution time of each cycle");
-    d.param("overrun_every", 0.0, "cycles", "every this many cycles one lasts longer (0: never)");
-    d.param("overrun", 0.0, "s", "how much longer that cycle lasts");
+    d.param("exec", 0.0, "s", "execution time of each cycle").at_least(0);
+    d.param("overrun_every", 0.0, "cycles", "every this many cycles one lasts longer (0: never)").whole().at_least(0);
+    d.param("overrun", 0.0, "s", "how much longer that cycle lasts").at_least(0);
     d.param("recover", false, "", "error() recovers from timing failures");
   }
 

@@ -26,13 +26,16 @@ class DampedLeastSquares final : public Module {
     d.in_var("x_m", Dim::fixed(6), "measured tool pose, as x_d");
     d.in_var("jacobian", Dim::of("ndof", 6), "geometric Jacobian, 6 x ndof row-major, rows vx vy vz wx wy wz");
     d.out_var("dtheta_d", Dim::of("ndof"), "desired joint velocities, rad/s");
-    d.param("gain", defaults.gain, "1/s", "tool twist commanded per unit of pose error");
-    d.param("max_linear_speed", defaults.max_linear_speed, "m/s", "the commanded tool speed is clipped to this");
-    d.param("max_angular_speed", defaults.max_angular_speed, "rad/s",
-            "the commanded tool turn rate is clipped to this");
-    d.param("max_damping", defaults.max_damping, "m", "lambda at a singularity (the damping when w = 0)");
+    d.param("gain", defaults.gain, "1/s", "tool twist commanded per unit of pose error").greater_than(0);
+    d.param("max_linear_speed", defaults.max_linear_speed, "m/s", "the commanded tool speed is clipped to this")
+        .greater_than(0);
+    d.param("max_angular_speed", defaults.max_angular_speed, "rad/s", "the commanded tool turn rate is clipped to this")
+        .greater_than(0);
+    d.param("max_damping", defaults.max_damping, "m", "lambda at a singularity (the damping when w = 0)")
+        .greater_than(0);
     d.param("manipulability_threshold", defaults.manipulability_threshold, "",
-            "w_0: the damping grows as w falls below it");
+            "w_0: the damping grows as w falls below it")
+        .greater_than(0);
   }
 
  protected:

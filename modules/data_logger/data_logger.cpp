@@ -83,7 +83,10 @@ class DataLogger final : public Module {
     for (const auto& v : variables_of(p)) d.in_var(v, Dim::follow(), "recorded, every element each cycle");
     d.param("variables", StringList{}, "", "state variables to record (one in-var port each)");
     d.param("file", std::string(), "", "CSV file; empty: <task>.csv; relative: below $CHIMERA_LOG_DIR if set");
-    d.param("capacity", 0.0, "rows", "ring size; 0: one second of rows at the task's period, at least 1024");
+    d.param("capacity", 0.0, "rows", "ring size; 0: one second of rows at the task's period, at least 1024")
+        .whole()
+        .at_least(0)
+        .at_most(1e8);
     d.resource("a CSV file, written by an ordinary (not real-time) thread");
   }
 

@@ -32,8 +32,12 @@ class InvKin final : public Module {
     d.in_var("theta_m", Dim::of("ndof"), "measured joint positions, rad (where the solution starts)");
     d.out_var("theta_d", Dim::of("ndof"), "desired joint positions, rad, within the joint limits");
     declare_chain_params(d);
-    d.param("max_iterations", kDefaultIterations, "", "Levenberg-Marquardt iterations per cycle at most");
-    d.param("tolerance", kDefaultTolerance, "m, rad", "position and orientation error at which a solution is done");
+    d.param("max_iterations", kDefaultIterations, "", "Levenberg-Marquardt iterations per cycle at most")
+        .whole()
+        .at_least(1)
+        .at_most(10000);
+    d.param("tolerance", kDefaultTolerance, "m, rad", "position and orientation error at which a solution is done")
+        .greater_than(0);
     d.param("lower", Vector{}, "rad", "lower joint limits (one per joint, or one for all); empty: the URDF's");
     d.param("upper", Vector{}, "rad", "upper joint limits; empty: the URDF's");
   }

@@ -40,8 +40,11 @@ class JoinWeightedAverage final : public Module {
       d.in_var(input_name(i), Dim::follow(),
                "one producer's value of the quantity (rename it to that producer's variable)");
     d.out_var("out", Dim::follow(), "the weighted average: the one value of the quantity (rename it to its variable)");
-    d.param("inputs", 0.0, "", "number of inputs in_0 ... in_{inputs-1}, from 2 to 64; 0: as many as weights, or 2");
-    d.param("weights", Vector{}, "", "weight of each input, >= 0, not all 0; empty: equal weights");
+    d.param("inputs", 0.0, "", "number of inputs in_0 ... in_{inputs-1}, from 2 to 64; 0: as many as weights, or 2")
+        .whole()
+        .at_least(0)
+        .at_most(64);
+    d.param("weights", Vector{}, "", "weight of each input, >= 0, not all 0; empty: equal weights").at_least(0);
   }
 
  protected:

@@ -28,9 +28,9 @@ class JointLowpass final : public Module {
     d.in_const("ndof", Dim::fixed(1), "degrees of freedom");
     d.in_var("u", Dim::of("ndof"), "input, one value per joint");
     d.out_var("y", Dim::of("ndof"), "filtered input");
-    d.param("cutoff_hz", kDefaultCutoffHz, "Hz", "cut-off frequency (-3 dB) of the filter");
+    d.param("cutoff_hz", kDefaultCutoffHz, "Hz", "cut-off frequency (-3 dB) of the filter").greater_than(0);
     d.param("late_limit", kDefaultLateLimit, "cycles",
-            "timing faults (late cycles, budget overruns) in a row that error() recovers from before ERROR");
+            "timing faults (late cycles, budget overruns) in a row that error() recovers from before ERROR").whole().at_least(1);
   }
 
  protected:

@@ -33,8 +33,8 @@ class JointTrajGen final : public Module {
     d.out_var("theta_d", Dim::of("ndof"), "desired joint positions, rad");
     d.out_var("dtheta_d", Dim::of("ndof"), "desired joint velocities, rad/s");
     d.param("via", default_via(), "rad", "via points, one joint vector (ndof entries) each");
-    d.param("segment_time", kDefaultSegmentTime, "s", "duration of each move between via points");
-    d.param("hold_time", kDefaultHoldTime, "s", "rest at each via point");
+    d.param("segment_time", kDefaultSegmentTime, "s", "duration of each move between via points").greater_than(0);
+    d.param("hold_time", kDefaultHoldTime, "s", "rest at each via point").at_least(0);
     d.param("loop", kDefaultLoop, "", "after the last via point go on to the first, forever");
   }
 

@@ -38,13 +38,15 @@ class PidJoint final : public Module {
     d.in_var("theta_m", Dim::of("ndof"), "measured joint positions, rad");
     d.in_var("dtheta_m", Dim::of("ndof"), "measured joint velocities, rad/s");
     d.out_var("tau_r", Dim::of("ndof"), "reference joint torques, N*m");
-    d.param("kp", default_kp(), "N*m/rad", "proportional gains (one per joint, or one for all)");
-    d.param("ki", default_ki(), "N*m/(rad*s)", "integral gains");
-    d.param("kd", default_kd(), "N*m*s/rad", "derivative gains, on the velocity error");
-    d.param("tau_max", default_tau_max(), "N*m", "output saturation per joint");
-    d.param("i_max", default_i_max(), "rad*s", "bound on the integral of the position error");
+    d.param("kp", default_kp(), "N*m/rad", "proportional gains (one per joint, or one for all)").at_least(0);
+    d.param("ki", default_ki(), "N*m/(rad*s)", "integral gains").at_least(0);
+    d.param("kd", default_kd(), "N*m*s/rad", "derivative gains, on the velocity error").at_least(0);
+    d.param("tau_max", default_tau_max(), "N*m", "output saturation per joint").at_least(0);
+    d.param("i_max", default_i_max(), "rad*s", "bound on the integral of the position error").at_least(0);
     d.param("late_limit", kDefaultLateLimit, "cycles",
-            "timing faults (late cycles, budget overruns) in a row that error() recovers from before ERROR");
+            "timing faults (late cycles, budget overruns) in a row that error() recovers from before ERROR")
+        .whole()
+        .at_least(1);
   }
 
  protected:

@@ -24,7 +24,7 @@ class RobotPosition final : public Module {
     const std::uint32_t n = robot_ndof(p);
     d.in_var("theta_d", Dim::fixed(n), "desired joint positions, rad (clamped to the joint ranges)");
     declare_simulated_arm(d, p);
-    d.param("bandwidth", sim::kDefaultServoBandwidthHz, "Hz", "bandwidth of the arm's position servo");
+    d.param("bandwidth", sim::kDefaultServoBandwidthHz, "Hz", "bandwidth of the arm's position servo").greater_than(0);
     d.param("max_speed", Vector(n, sim::kDefaultServoMaxSpeed), "rad/s",
             "fastest joint motion toward theta_d (one per joint, or one for all)");
     d.param("max_acceleration", Vector{}, "rad/s^2",

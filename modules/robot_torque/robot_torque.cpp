@@ -24,7 +24,8 @@ class RobotTorque final : public Module {
     d.in_var("tau_r", Dim::fixed(robot_ndof(p)), "reference joint torques, N*m (clamped to the arm's limits)");
     declare_simulated_arm(d, p);
     d.param("hold_bandwidth", sim::kDefaultServoBandwidthHz, "Hz",
-            "bandwidth of the hold while the illegal-configuration flag is raised");
+            "bandwidth of the hold while the illegal-configuration flag is raised")
+        .greater_than(0);
   }
 
  protected:

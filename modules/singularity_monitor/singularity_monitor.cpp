@@ -25,7 +25,7 @@ class SingularityMonitor final : public Module {
     d.in_const("ndof", Dim::fixed(1), "degrees of freedom");
     d.in_var("jacobian", Dim::of("ndof", 6), "geometric Jacobian, 6 x ndof row-major");
     d.out_var("manipulability", Dim::fixed(1), "w = sqrt(det(J J^T))");
-    d.param("enter", 0.06, "", "below this manipulability it asks for `near`");
+    d.param("enter", 0.06, "", "below this manipulability it asks for `near`").greater_than(0);
     d.param("leave", 0.075, "", "above this manipulability it asks for `safe`");
     d.param("near", std::string("near_singularity"), "", "configuration to ask for near a singular posture");
     d.param("safe", std::string("standard"), "", "configuration to ask for once away from it");

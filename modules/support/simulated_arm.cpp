@@ -25,13 +25,15 @@ void declare_simulated_arm(Declarations& d, const Params& p) {
   d.out_var("theta_m", Dim::fixed(n), "measured joint positions, rad");
   d.out_var("dtheta_m", Dim::fixed(n), "measured joint velocities, rad/s");
   d.out_const("ndof", {static_cast<double>(n)}, "degrees of freedom of the arm");
-  d.param("ndof", kDefaultNdof, "", "number of joints; must match the model");
+  d.param("ndof", kDefaultNdof, "", "number of joints; must match the model").whole().at_least(1).at_most(64);
   d.param("model", std::string(), "", "MJCF model file; empty: the shipped arm6.xml");
-  d.param("noise_std", 0.0, "rad", "standard deviation of Gaussian noise on theta_m");
+  d.param("noise_std", 0.0, "rad", "standard deviation of Gaussian noise on theta_m").at_least(0);
   d.param("seed", 1.0, "", "seed of the measurement noise (runs repeat exactly)");
   d.param("initial", Vector(n, 0.0), "rad", "joint positions at init");
   d.param("late_limit", kDefaultLateLimit, "cycles",
-          "timing faults (late cycles, budget overruns) in a row that error() recovers from before ERROR");
+          "timing faults (late cycles, budget overruns) in a row that error() recovers from before ERROR")
+      .whole()
+      .at_least(1);
   d.resource("MuJoCo simulation of a PUMA 560-like 6-joint arm (sim/models/arm6.xml), stepped by the task's period");
 }
 

@@ -69,13 +69,18 @@ class TeleopInput final : public Module {
     d.in_var("x_m", Dim::fixed(6), "measured tool pose [x y z rx ry rz], m and rad");
     d.out_var("x_goal", Dim::fixed(6), "goal tool pose, m and rad (NaN until x_m is known)");
     d.out_var("teleop_stats", Dim::fixed(3), "[commands accepted, commands refused, UDP port bound]");
-    d.param("source", std::string("udp"), "", "udp (datagrams on address:port) or replay (session or record)");
+    d.param("source", std::string("udp"), "", "udp (datagrams on address:port) or replay (session or record)")
+        .one_of({"udp", "replay"});
     d.param("address", std::string("127.0.0.1"), "", "IPv4 address to bind (udp)");
-    d.param("port", 0.0, "", "UDP port to bind; 0: the system chooses (teleop_stats[2] says which)");
+    d.param("port", 0.0, "", "UDP port to bind; 0: the system chooses (teleop_stats[2] says which)")
+        .whole()
+        .at_least(0)
+        .at_most(65535);
     d.param("session", StringList{}, "", "recorded commands, `seconds command` each (replay)");
     d.param("record", std::string(), "", "a file of recorded commands, one `seconds command` a line (replay)");
-    d.param("timeout", 0.5, "s", "a vel motion stops after this long without a command");
-    d.param("max_distance", 0.5, "m", "the goal's position stays this close to where it started (0: no limit)");
+    d.param("timeout", 0.5, "s", "a vel motion stops after this long without a command").greater_than(0);
+    d.param("max_distance", 0.5, "m", "the goal's position stays this close to where it started (0: no limit)")
+        .at_least(0);
     d.resource("UDP datagrams of operator commands, or a recorded session replayed on the subsystem's clock");
   }
 

@@ -27,7 +27,7 @@ class TimeIntegrator final : public Module {
     d.in_var("dtheta_d", Dim::of("ndof"), "desired joint velocities, rad/s");
     d.in_var("theta_m", Dim::of("ndof"), "measured joint positions, rad (the start, and the bound on the lead)");
     d.out_var("theta_d", Dim::of("ndof"), "desired joint positions, rad");
-    d.param("max_lead", kDefaultMaxLead, "rad", "theta_d stays within this of theta_m (0: unbounded)");
+    d.param("max_lead", kDefaultMaxLead, "rad", "theta_d stays within this of theta_m (0: unbounded)").at_least(0);
     d.param("lower", Vector{}, "rad", "lower bounds on theta_d (one per joint, or one for all); empty: none");
     d.param("upper", Vector{}, "rad", "upper bounds on theta_d; empty: none");
   }

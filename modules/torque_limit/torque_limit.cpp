@@ -26,9 +26,9 @@ class TorqueLimit final : public Module {
     d.in_const("ndof", Dim::fixed(1), "degrees of freedom");
     d.in_var("tau_in", Dim::of("ndof"), "requested joint torques, N*m");
     d.out_var("tau_out", Dim::of("ndof"), "joint torques clamped to +-limit, N*m");
-    d.param("limit", default_limit(), "N*m", "torque limit per joint (or one for all)");
+    d.param("limit", default_limit(), "N*m", "torque limit per joint (or one for all)").at_least(0);
     d.param("late_limit", kDefaultLateLimit, "cycles",
-            "timing faults (late cycles, budget overruns) in a row that error() recovers from before ERROR");
+            "timing faults (late cycles, budget overruns) in a row that error() recovers from before ERROR").whole().at_least(1);
   }
 
  protected:

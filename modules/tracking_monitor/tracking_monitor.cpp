@@ -21,7 +21,7 @@ class TrackingMonitor final : public Module {
     d.in_var("theta_d", Dim::of("ndof"), "desired joint positions, rad");
     d.in_var("theta_m", Dim::of("ndof"), "measured joint positions, rad");
     d.out_var("tracking_error", Dim::fixed(3), "[max |e| now, RMS since on, worst max |e| since on], rad");
-    d.param("settle_time", 0.5, "s", "time after on that the RMS and the worst value ignore");
+    d.param("settle_time", 0.5, "s", "time after on that the RMS and the worst value ignore").at_least(0);
   }
 
  protected:

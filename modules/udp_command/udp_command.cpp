@@ -42,9 +42,12 @@ class UdpCommand final : public Module {
     d.out_var("command_stats", Dim::fixed(2), "[datagrams accepted, datagrams rejected]");
     d.out_var("udp_port", Dim::fixed(1), "the UDP port the socket is bound to");
     d.param("address", std::string("127.0.0.1"), "", "IPv4 address to bind");
-    d.param("port", 0.0, "", "UDP port to bind (0: the system chooses; see udp_port)");
-    d.param("size", kDefaultSize, "", "numbers per datagram");
-    d.param("cost", 0.0, "s", "simulated execution time per datagram on the virtual clock");
+    d.param("port", 0.0, "", "UDP port to bind (0: the system chooses; see udp_port)")
+        .whole()
+        .at_least(0)
+        .at_most(65535);
+    d.param("size", kDefaultSize, "", "numbers per datagram").whole().at_least(1).at_most(256);
+    d.param("cost", 0.0, "s", "simulated execution time per datagram on the virtual clock").at_least(0);
     d.resource("a UDP socket: each datagram is one event");
   }
 

@@ -38,11 +38,15 @@ class VisualServo final : public Module {
   static void declare(Declarations& d, const Params& /*params*/) {
     d.in_var("x_m", Dim::fixed(6), "measured tool pose [x y z rx ry rz]: m, and a rotation vector in rad");
     d.out_var("x_d", Dim::fixed(6), "desired tool pose, as x_m");
-    d.param("gain", 1.0, "", "fraction of the way from x_m to the seen target that x_d asks for (0 to 1]");
-    d.param("latency", kDefaultLatency, "s", "age of the image a result comes from");
-    d.param("position_noise", kDefaultPositionNoise, "m", "standard deviation of the error of each seen coordinate");
+    d.param("gain", 1.0, "", "fraction of the way from x_m to the seen target that x_d asks for (0 to 1]")
+        .greater_than(0)
+        .at_most(1);
+    d.param("latency", kDefaultLatency, "s", "age of the image a result comes from").at_least(0);
+    d.param("position_noise", kDefaultPositionNoise, "m", "standard deviation of the error of each seen coordinate")
+        .at_least(0);
     d.param("orientation_noise", kDefaultOrientationNoise, "rad",
-            "standard deviation of the seen orientation's error about each axis");
+            "standard deviation of the seen orientation's error about each axis")
+        .at_least(0);
     d.param("seed", 1.0, "", "seed of the noise (runs repeat exactly)");
     d.param("center", default_center(), "m, rad", "the target's mean pose [x y z rx ry rz]");
     d.param("amplitude", default_amplitude(), "m, rad", "amplitude of each number's sine wave");

@@ -11,6 +11,7 @@
 #include <cstring>
 #include <deque>
 #include <memory>
+#include <optional>
 #include <string>
 #include <variant>
 #include <vector>
@@ -197,6 +198,35 @@ void chimera_param_vector(chimera_decl* d, const char* name, const double* value
   chimera::Vector v;
   if (values != nullptr) v.assign(values, values + count);
   decl_of(d).param(text_or_empty(name), std::move(v), text_or_empty(unit), text_or_empty(doc));
+}
+namespace {
+// The rule of a parameter the C module declared, or nullopt after refusing the module.
+std::optional<chimera::ParamRuleBuilder> rule_for(chimera_decl* d, const char* name, const char* what) {
+  chimera::ParamRule* rule = decl_of(d).rule_of(text_or_empty(name));
+  if (rule == nullptr) {
+    decl_of(d).refuse(fmt::format("{} for parameter '{}', which is not declared before it", what, text_or_empty(name)));
+    return std::nullopt;
+  }
+  return chimera::ParamRuleBuilder(*rule);
+}
+}  // namespace
+
+void chimera_param_at_least(chimera_decl* d, const char* name, double lower) {
+  if (auto r = rule_for(d, name, "chimera_param_at_least")) r->at_least(lower);
+}
+void chimera_param_greater_than(chimera_decl* d, const char* name, double lower) {
+  if (auto r = rule_for(d, name, "chimera_param_greater_than")) r->greater_than(lower);
+}
+void chimera_param_at_most(chimera_decl* d, const char* name, double upper) {
+  if (auto r = rule_for(d, name, "chimera_param_at_most")) r->at_most(upper);
+}
+void chimera_param_less_than(chimera_decl* d, const char* name, double upper) {
+  if (auto r = rule_for(d, name, "chimera_param_less_than")) r->less_than(upper);
+}
+void chimera_param_one_of(chimera_decl* d, const char* name, const char* const* choices, size_t count) {
+  std::vector<std::string> list;
+  for (size_t i = 0; choices != nullptr && i < count; ++i) list.emplace_back(text_or_empty(choices[i]));
+  if (auto r = rule_for(d, name, "chimera_param_one_of")) r->one_of(std::move(list));
 }
 void chimera_resource(chimera_decl* d, const char* what) { decl_of(d).resource(text_or_empty(what)); }
 

@@ -47,6 +47,18 @@ std::string check_param(const Declarations& decls, std::size_t i) {
   if (!is_identifier(p.name))
     return fmt::format("parameter '{}' is not a valid name (letters, digits and _, not starting with a digit)", p.name);
   if (declared_twice(decls.params(), i)) return fmt::format("parameter {} is declared twice", p.name);
+  const ParamRule& rule = p.rule;
+  const bool numeric = p.type == ParamType::kNumber || p.type == ParamType::kVector || p.type == ParamType::kMatrix;
+  const bool textual = p.type == ParamType::kString || p.type == ParamType::kStringList;
+  if ((rule.lower || rule.upper || rule.whole) && !numeric)
+    return fmt::format("parameter {} is {}, which cannot have a range", p.name, param_type_name(p.type));
+  if (!rule.choices.empty() && !textual)
+    return fmt::format("parameter {} is {}, which cannot have choices", p.name, param_type_name(p.type));
+  if (rule.lower && rule.upper &&
+      (*rule.lower > *rule.upper || (*rule.lower == *rule.upper && (rule.lower_exclusive || rule.upper_exclusive))))
+    return fmt::format("parameter {}: its range {} holds no value", p.name, describe(rule));
+  if (auto why = rule_violation(rule, p.default_value); !why.empty())
+    return fmt::format("parameter {}: its default {} breaks its own rule: {}", p.name, to_string(p.default_value), why);
   return {};
 }
 
@@ -64,7 +76,7 @@ Result<void> check_module(const ModuleInfo& info) {
   } catch (...) {
     return make_error(Errc::kInvalidInput, fmt::format("module {}: declare() threw", info.name));
   }
-  std::string problem;
+  std::string problem = decls.problems().empty() ? std::string() : decls.problems().front();
   for (std::size_t i = 0; i < decls.ports().size() && problem.empty(); ++i) problem = check_port(decls, i);
   for (std::size_t i = 0; i < decls.params().size() && problem.empty(); ++i) problem = check_param(decls, i);
   if (problem.empty()) return {};

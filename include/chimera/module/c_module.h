@@ -93,6 +93,14 @@ void chimera_param_bool(chimera_decl* d, const char* name, int value, const char
 void chimera_param_string(chimera_decl* d, const char* name, const char* value, const char* unit, const char* doc);
 void chimera_param_vector(chimera_decl* d, const char* name, const double* values, size_t count, const char* unit,
                           const char* doc);
+/* The values a parameter declared above accepts (docs/writing-modules.md, "Parameter ranges"):
+ * a bound below or above for a number (each element of a vector), choices for a string. Checked
+ * by chimera verify with the file's line. A rule for a name not declared refuses the module. */
+void chimera_param_at_least(chimera_decl* d, const char* name, double lower);
+void chimera_param_greater_than(chimera_decl* d, const char* name, double lower);
+void chimera_param_at_most(chimera_decl* d, const char* name, double upper);
+void chimera_param_less_than(chimera_decl* d, const char* name, double upper);
+void chimera_param_one_of(chimera_decl* d, const char* name, const char* const* choices, size_t count);
 /* What the module's resource port talks to (hardware, a simulation, a socket), for docs. */
 void chimera_resource(chimera_decl* d, const char* what);
 

@@ -4,9 +4,11 @@
 
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
+#include "chimera/module/param_rule.hpp"
 #include "chimera/module/params.hpp"
 #include "chimera/svt/elem_type.hpp"
 #include "chimera/svt/port_kind.hpp"
@@ -45,6 +47,7 @@ struct ParamDecl {
   ParamValue default_value;
   std::string unit;  // "rad", "N*m/rad", "" for none
   std::string doc;
+  ParamRule rule{};  // the values it accepts beyond its type (none: any)
 };
 
 /// Filled by a module's static declare(Declarations&, const Params&).
@@ -69,10 +72,25 @@ class Declarations {
     ports_.push_back(
         {std::move(name), PortKind::kOutConst, ElemType::kF64, Dim::fixed(n), std::move(value), std::move(doc)});
   }
-  void param(std::string name, ParamValue default_value, std::string unit, std::string doc) {
+  /// A parameter with its default; chain a rule on what it returns, in the same statement:
+  /// `d.param("cutoff_hz", 10.0, "Hz", "corner frequency").greater_than(0);` (param_rule.hpp).
+  ParamRuleBuilder param(std::string name, ParamValue default_value, std::string unit, std::string doc) {
     const ParamType type = param_type_of(default_value);
-    params_.push_back({std::move(name), type, std::move(default_value), std::move(unit), std::move(doc)});
+    params_.push_back({std::move(name), type, std::move(default_value), std::move(unit), std::move(doc), {}});
+    return ParamRuleBuilder(params_.back().rule);
   }
+  /// The rule of the parameter `name` declared before, or nullptr (the C interface sets rules by
+  /// name, after the parameter).
+  [[nodiscard]] ParamRule* rule_of(std::string_view name) {
+    for (auto& p : params_)
+      if (p.name == name) return &p.rule;
+    return nullptr;
+  }
+  /// A mistake in the declarations that no field can hold (a rule for a parameter never
+  /// declared): the module is refused at registration with it.
+  void refuse(std::string problem) { problems_.push_back(std::move(problem)); }
+  [[nodiscard]] const std::vector<std::string>& problems() const { return problems_; }
+
   /// What the module's resource port talks to (hardware, a simulation, a socket), for docs.
   void resource(std::string what) { resource_ = std::move(what); }
 
@@ -83,6 +101,7 @@ class Declarations {
  private:
   std::vector<PortDecl> ports_;
   std::vector<ParamDecl> params_;
+  std::vector<std::string> problems_;
   std::string resource_;
 };
 

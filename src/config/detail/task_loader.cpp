@@ -182,6 +182,9 @@ Result<Params> read_params(const Source& source, const std::optional<Field>& fie
         return source.fail(
             value, fmt::format("{} is {}, but {} of {} takes {}", to_string(*v), with_article(param_type_of(*v)), name,
                                info.name, with_article(decl->type)));
+      // The declared range or choices: what init would refuse, refused here with the line.
+      if (auto why = rule_violation(decl->rule, *v); !why.empty())
+        return source.fail(value, fmt::format("{} given: {}", to_string(*v), why));
       params.set(name, *std::move(v));
     }
   }

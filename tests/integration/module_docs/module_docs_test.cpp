@@ -90,10 +90,11 @@ TEST(ModuleDocs, EveryModuleHasAPageThatSaysWhatItDeclares) {
     for (const auto& p : d.params()) {
       const auto row = params.find(p.name);
       ASSERT_NE(row, params.end()) << "parameter " << p.name << " is not in the Parameters table";
-      ASSERT_GE(row->second.size(), 4U);
+      ASSERT_GE(row->second.size(), 5U);
       EXPECT_EQ(row->second[1], param_type_name(p.type)) << p.name;
       EXPECT_EQ(row->second[2], p.unit.empty() ? "—" : p.unit) << p.name;
       EXPECT_EQ(row->second[3], "`" + to_string(p.default_value) + "`") << p.name;
+      EXPECT_EQ(row->second[4], p.rule.empty() ? "—" : "`" + describe(p.rule) + "`") << p.name << ": what it accepts";
     }
   }
 }

@@ -36,12 +36,12 @@ inline Registry make_test_registry() {
     d.in_const("ndof", Dim::fixed(1), "degrees of freedom");
     for (const char* in : {"theta_d", "dtheta_d", "theta_m", "dtheta_m"}) d.in_var(in, n, "joint state");
     d.out_var("tau_r", n, "reference torques");
-    d.param("kp", 100.0, "N*m/rad", "proportional gain");
+    d.param("kp", 100.0, "N*m/rad", "proportional gain").at_least(0);
     d.param("ki", 0.0, "N*m/(rad*s)", "integral gain");
     d.param("kd", 10.0, "N*m*s/rad", "derivative gain");
     d.param("enabled", true, "", "output torques at all");
-    d.param("label", std::string("pid"), "", "name in logs");
-    d.param("limits", Vector{}, "N*m", "torque limits per joint");
+    d.param("label", std::string("pid"), "", "name in logs").one_of({"pid", "pd"});
+    d.param("limits", Vector{}, "N*m", "torque limits per joint").greater_than(0);
   });
   // The robot interfaces publish ndof themselves, from a parameter so tests can build a 7-dof arm.
   add_fake(r, "robot_torque", [n](Declarations& d, const Params& p) {

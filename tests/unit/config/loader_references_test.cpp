@@ -27,6 +27,20 @@ TEST(LoaderReferences, UnknownParameterListsTheKnownOnes) {
             "pid.yaml:5: tasks[0].params.gain: unknown parameter (fwd_kin_jacobian takes none)");
 }
 
+// A declared range or list of choices (module/param_rule.hpp): what init would refuse is refused
+// by the loader, so `chimera verify` names the line.
+TEST(LoaderReferences, AValueOutsideItsDeclaredRangeIsRefusedWithItsLine) {
+  EXPECT_EQ(error_of(kPidHead + "      kd: 1\n      kp: -1\n"),
+            "pid.yaml:7: tasks[0].params.kp: -1 given: must be >= 0");
+  EXPECT_EQ(error_of(kPidHead + "      limits: [10, 0, 5]\n"),
+            "pid.yaml:6: tasks[0].params.limits: [10, 0, 5] given: element 1 is 0, must be > 0");
+  EXPECT_EQ(error_of(kPidHead + "      label: pi\n"),
+            "pid.yaml:6: tasks[0].params.label: \"pi\" given: must be one of: pid, pd");
+  const auto bounds =
+      load_subsystem_text(kPidHead + "      kp: 0\n      label: pd\n      limits: [1]\n", "pid.yaml", registry());
+  EXPECT_TRUE(bounds.ok()) << "the bounds themselves pass: " << (bounds.ok() ? "" : bounds.error().message);
+}
+
 TEST(LoaderReferences, WrongParameterTypeNamesTheExpectedType) {
   EXPECT_EQ(error_of(kPidHead + "      kp: high\n"),
             "pid.yaml:6: tasks[0].params.kp: \"high\" is a string, but kp of pid_joint takes a number");

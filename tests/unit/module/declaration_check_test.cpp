@@ -94,5 +94,21 @@ TEST(CheckModule, ADeclareThatThrowsIsAFlaw) {
   EXPECT_EQ(r.error().message, "module m: declare() threw: boom");
 }
 
+TEST(CheckModule, ParameterRulesThatCannotHoldAreRefused) {
+  EXPECT_EQ(flaw([](Declarations& d) { d.param("gain", 1.0, "", "").at_least(2); }),
+            "module m: parameter gain: its default 1 breaks its own rule: must be >= 2");
+  EXPECT_EQ(flaw([](Declarations& d) { d.param("gain", 1.0, "", "").greater_than(3).less_than(2); }),
+            "module m: parameter gain: its range > 3 and < 2 holds no value");
+  EXPECT_EQ(flaw([](Declarations& d) { d.param("gain", 1.0, "", "").at_least(1).less_than(1); }),
+            "module m: parameter gain: its range >= 1 and < 1 holds no value");
+  EXPECT_EQ(flaw([](Declarations& d) { d.param("name", std::string("x"), "", "").at_least(0); }),
+            "module m: parameter name is string, which cannot have a range");
+  EXPECT_EQ(flaw([](Declarations& d) { d.param("on", true, "", "").one_of({"yes"}); }),
+            "module m: parameter on is bool, which cannot have choices");
+  EXPECT_EQ(flaw([](Declarations& d) { d.refuse("a rule for parameter 'k', which is not declared before it"); }),
+            "module m: a rule for parameter 'k', which is not declared before it");
+  EXPECT_EQ(flaw([](Declarations& d) { d.param("gain", 1.0, "", "").at_least(1).at_most(1); }), "");
+}
+
 }  // namespace
 }  // namespace chimera::module_detail

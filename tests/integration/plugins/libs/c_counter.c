@@ -23,9 +23,14 @@ static void counter_declare(chimera_decl* d, const chimera_params* p) {
   chimera_out_var(d, "seen", chimera_dim_fixed((uint32_t)width), "[freshness of u, release s, period s]");
   chimera_param_number(d, "offset", 0.0, "", "added to the count");
   chimera_param_number(d, "width", 3.0, "", "size of seen (at least 3)");
+  chimera_param_at_least(d, "width", 3.0); /* a rule chimera verify checks, with the file's line */
   chimera_param_number(d, "fail_at", -1.0, "cycles", "cycle that fails (-1: none)");
   chimera_param_bool(d, "recover", 0, "", "error() recovers");
   chimera_param_string(d, "label", "counter", "", "a text parameter");
+  {
+    const char* const labels[] = {"counter", "other"};
+    chimera_param_one_of(d, "label", labels, 2);
+  }
   {
     const double gains[2] = {1.0, 2.0};
     chimera_param_vector(d, "gains", gains, 2, "", "a vector parameter");
