@@ -82,7 +82,7 @@ TEST(JoinWeightedAverage, RefusesBadWeightsAndMixedShapes) {
   EXPECT_NE(
       start_error(replaced(kFile, "weights: [1, 2, 5]", "inputs: 3, weights: [1, 2]")).find("2 weights for 3 inputs"),
       std::string::npos);
-  EXPECT_NE(start_error(replaced(kFile, "weights: [1, 2, 5]", "weights: [1, -2, 5]")).find("weights must be >= 0"),
+  EXPECT_NE(start_error(replaced(kFile, "weights: [1, 2, 5]", "weights: [1, -2, 5]")).find("params.weights: [1, -2, 5] given: element 1 is -2, must be >= 0"),
             std::string::npos);
   EXPECT_NE(start_error(replaced(kFile, "weights: [1, 2, 5]", "weights: [0, 0, 0]")).find("must not all be 0"),
             std::string::npos);

@@ -53,7 +53,7 @@ TEST(JointLowpass, StartsAtItsFirstInputAndFollowsAStepExactly) {
 }
 
 TEST(JointLowpass, RefusesACutoffThatIsNotPositive) {
-  EXPECT_NE(start_error(replaced(kFilterFile, "cutoff_hz: 20", "cutoff_hz: 0")).find("cutoff_hz must be a number > 0"),
+  EXPECT_NE(start_error(replaced(kFilterFile, "cutoff_hz: 20", "cutoff_hz: 0")).find("params.cutoff_hz: 0 given: must be > 0"),
             std::string::npos);
 }
 
@@ -71,7 +71,7 @@ TEST(TorqueLimit, ClampsEachJointToItsLimit) {
 }
 
 TEST(TorqueLimit, RefusesANegativeLimit) {
-  EXPECT_NE(start_error(replaced(kLimitFile, "limit: [1, 2, 0.5]", "limit: [1, -2, 0.5]")).find("none negative"),
+  EXPECT_NE(start_error(replaced(kLimitFile, "limit: [1, 2, 0.5]", "limit: [1, -2, 0.5]")).find("params.limit: [1, -2, 0.5] given: element 1 is -2, must be >= 0"),
             std::string::npos);
 }
 

@@ -124,7 +124,7 @@ TEST(RobotPosition, TwoRunsAreBitIdentical) {
 TEST(RobotPosition, BadParametersAreNamed) {
   ScriptedSource::set("goal", std::vector<double>(6, 0.0));
   EXPECT_NE(start_error(replaced(kStep, "initial: [0, 0, 0, 0, 0, 0]", "initial: [0, 0, 0, 0, 0, 0], bandwidth: 0"))
-                .find("bandwidth must be > 0"),
+                .find("params.bandwidth: 0 given: must be > 0"),
             std::string::npos);
   EXPECT_NE(
       start_error(replaced(kStep, "initial: [0, 0, 0, 0, 0, 0]", "initial: [0, 0, 0, 0, 0, 0], max_speed: [1, 2]"))

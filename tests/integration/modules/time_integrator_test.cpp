@@ -82,7 +82,7 @@ TEST(TimeIntegrator, MustBePeriodicAndWellBounded) {
   EXPECT_NE(start_error(replaced(kFile, "module: time_integrator, period: 2ms,", "module: time_integrator,"))
                 .find("must be periodic"),
             std::string::npos);
-  EXPECT_NE(start_error(replaced(kFile, "max_lead: 0", "max_lead: -1")).find("max_lead must be >= 0"),
+  EXPECT_NE(start_error(replaced(kFile, "max_lead: 0", "max_lead: -1")).find("params.max_lead: -1 given: must be >= 0"),
             std::string::npos);
   EXPECT_NE(start_error(replaced(kFile, "max_lead: 0", "lower: [1], upper: [0]")).find("a lower bound is above"),
             std::string::npos);

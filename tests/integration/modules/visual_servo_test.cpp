@@ -196,9 +196,9 @@ tasks:
 TEST(VisualServo, BadParametersDoNotStart) {
   ScriptedSource::set("tool", {0.7, 0.0, 0.9, 0.0, 2.0, 0.0});
   EXPECT_NE(start_error(replaced(kFile, "      latency: 0.075\n", "      latency: 0.075\n      gain: 0\n"))
-                .find("gain must be in (0, 1]"),
+                .find("params.gain: 0 given: must be > 0 and <= 1"),
             std::string::npos);
-  EXPECT_NE(start_error(replaced(kFile, "latency: 0.075", "latency: -1")).find("must be >= 0"), std::string::npos);
+  EXPECT_NE(start_error(replaced(kFile, "latency: 0.075", "latency: -1")).find("params.latency: -1 given: must be >= 0"), std::string::npos);
   EXPECT_NE(start_error(replaced(kFile, "phase: [0, 1, 2, 3, 4, 5]", "phase: [0, 1]")).find("need 6 (or 1)"),
             std::string::npos);
 }

@@ -54,13 +54,13 @@ class CModuleTest : public ::testing::Test {
 
 TEST_F(CModuleTest, ItsParameterRulesAreCheckedByTheLoader) {
   const auto head =
-      std::string("subsystem: c\ntasks:\n  - name: k\n    module: c_counter\n    period: 1ms\n    params:\n");
+      std::string("subsystem: c\ntasks:\n  - name: k\n    module: test_c_counter\n    period: 1ms\n    params:\n");
   auto narrow = load_subsystem_text(head + "      width: 2\n", "c.yaml", Registry::global());
   ASSERT_FALSE(narrow.ok());
   EXPECT_EQ(narrow.error().message, "c.yaml:7: tasks[0].params.width: 2 given: must be >= 3");
   auto label = load_subsystem_text(head + "      label: x\n", "c.yaml", Registry::global());
   ASSERT_FALSE(label.ok());
-  EXPECT_EQ(label.error().message, "c.yaml:7: tasks[0].params.label: \"x\" given: must be one of: counter, other");
+  EXPECT_EQ(label.error().message, "c.yaml:7: tasks[0].params.label: \"x\" given: must be one of: counter, other, refuse");
   EXPECT_TRUE(load_subsystem_text(head + "      width: 4\n      label: other\n", "c.yaml", Registry::global()).ok());
 }
 

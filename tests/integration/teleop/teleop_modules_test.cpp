@@ -125,12 +125,16 @@ TEST_F(TeleopTest, DatagramsAreCommandsAndNonsenseIsCounted) {
 
 TEST_F(TeleopTest, ABadSessionDoesNotStart) {
   for (const char* params : {"{ source: replay, session: ['0.5 jump 1 2 3'] }", "{ source: replay }",
-                             "{ source: replay, session: ['1 stop', '0.5 stop'] }", "{ source: joystick }",
+                             "{ source: replay, session: ['1 stop', '0.5 stop'] }",
                              "{ source: replay, record: /no/such/file.txt }"}) {
     auto s = start(std::string("  - { name: teleop, module: teleop_input, period: 10ms, params: ") + params + " }\n");
     EXPECT_EQ(s, nullptr) << params;
     EXPECT_NE(error_.find("teleop_input: "), std::string::npos) << params << ": " << error_;
   }
+  // An unknown source is refused by its declared choices, before init, with the line.
+  auto s = start("  - { name: teleop, module: teleop_input, period: 10ms, params: { source: joystick } }\n");
+  EXPECT_EQ(s, nullptr);
+  EXPECT_NE(error_.find("params.source: \"joystick\" given: must be one of: udp, replay"), std::string::npos) << error_;
 }
 
 TEST_F(TeleopTest, TheInterpolationStartsWhereTheToolIsAndReachesTheGoal) {

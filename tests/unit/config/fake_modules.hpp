@@ -40,8 +40,11 @@ inline Registry make_test_registry() {
     d.param("ki", 0.0, "N*m/(rad*s)", "integral gain");
     d.param("kd", 10.0, "N*m*s/rad", "derivative gain");
     d.param("enabled", true, "", "output torques at all");
-    d.param("label", std::string("pid"), "", "name in logs").one_of({"pid", "pd"});
-    d.param("limits", Vector{}, "N*m", "torque limits per joint").greater_than(0);
+    d.param("label", std::string("pid"), "", "name in logs");
+    d.param("limits", Vector{}, "N*m", "torque limits per joint");
+    // Declared ranges and choices (module/param_rule.hpp), apart from the free parameters above.
+    d.param("form", std::string("pid"), "", "control law").one_of({"pid", "pd"});
+    d.param("caps", Vector{}, "N*m", "positive torque caps per joint").greater_than(0);
   });
   // The robot interfaces publish ndof themselves, from a parameter so tests can build a 7-dof arm.
   add_fake(r, "robot_torque", [n](Declarations& d, const Params& p) {

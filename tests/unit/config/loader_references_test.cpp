@@ -21,8 +21,8 @@ const std::string kPidHead = "subsystem: s\ntasks:\n  - name: pid\n    module: p
 
 TEST(LoaderReferences, UnknownParameterListsTheKnownOnes) {
   EXPECT_EQ(error_of(kPidHead + "      kp: 1\n      kq: 2\n"),
-            "pid.yaml:7: tasks[0].params.kq: unknown parameter of pid_joint (known: enabled, kd, ki, kp, label, "
-            "limits)");
+            "pid.yaml:7: tasks[0].params.kq: unknown parameter of pid_joint (known: caps, enabled, form, kd, ki, kp, "
+            "label, limits)");
   EXPECT_EQ(error_of("subsystem: s\ntasks:\n  - name: fk\n    module: fwd_kin_jacobian\n    params: {gain: 1}\n"),
             "pid.yaml:5: tasks[0].params.gain: unknown parameter (fwd_kin_jacobian takes none)");
 }
@@ -32,12 +32,12 @@ TEST(LoaderReferences, UnknownParameterListsTheKnownOnes) {
 TEST(LoaderReferences, AValueOutsideItsDeclaredRangeIsRefusedWithItsLine) {
   EXPECT_EQ(error_of(kPidHead + "      kd: 1\n      kp: -1\n"),
             "pid.yaml:7: tasks[0].params.kp: -1 given: must be >= 0");
-  EXPECT_EQ(error_of(kPidHead + "      limits: [10, 0, 5]\n"),
-            "pid.yaml:6: tasks[0].params.limits: [10, 0, 5] given: element 1 is 0, must be > 0");
-  EXPECT_EQ(error_of(kPidHead + "      label: pi\n"),
-            "pid.yaml:6: tasks[0].params.label: \"pi\" given: must be one of: pid, pd");
+  EXPECT_EQ(error_of(kPidHead + "      caps: [10, 0, 5]\n"),
+            "pid.yaml:6: tasks[0].params.caps: [10, 0, 5] given: element 1 is 0, must be > 0");
+  EXPECT_EQ(error_of(kPidHead + "      form: pi\n"),
+            "pid.yaml:6: tasks[0].params.form: \"pi\" given: must be one of: pid, pd");
   const auto bounds =
-      load_subsystem_text(kPidHead + "      kp: 0\n      label: pd\n      limits: [1]\n", "pid.yaml", registry());
+      load_subsystem_text(kPidHead + "      kp: 0\n      form: pd\n      caps: [1]\n", "pid.yaml", registry());
   EXPECT_TRUE(bounds.ok()) << "the bounds themselves pass: " << (bounds.ok() ? "" : bounds.error().message);
 }
 

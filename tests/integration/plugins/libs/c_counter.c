@@ -28,8 +28,8 @@ static void counter_declare(chimera_decl* d, const chimera_params* p) {
   chimera_param_bool(d, "recover", 0, "", "error() recovers");
   chimera_param_string(d, "label", "counter", "", "a text parameter");
   {
-    const char* const labels[] = {"counter", "other"};
-    chimera_param_one_of(d, "label", labels, 2);
+    const char* const labels[] = {"counter", "other", "refuse"}; /* refuse: init says no */
+    chimera_param_one_of(d, "label", labels, 3);
   }
   {
     const double gains[2] = {1.0, 2.0};
