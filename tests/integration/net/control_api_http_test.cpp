@@ -173,7 +173,10 @@ TEST_F(ControlApiHttpTest, EveryShellCommandOverHttp) {
   for (const auto& c : commands) roles[c["verb"].get<std::string>()] = c["role"].get<std::string>();
   EXPECT_EQ(roles["status"], "viewer");
   EXPECT_EQ(roles["on"], "operator");
-  EXPECT_EQ(roles.size(), 13U);
+  EXPECT_EQ(roles["add"], "operator");  // live assembly changes the subsystem
+  EXPECT_EQ(roles["verify"], "viewer");  // checks, changes nothing
+  EXPECT_EQ(roles["save"], "viewer");    // over the network save only replies with the file
+  EXPECT_EQ(roles.size(), 18U);
 
   // quit stops the subsystem cleanly: the process ends with the timing table.
   r = run("quit");
@@ -500,9 +503,9 @@ TEST_F(ControlApiHttpTest, LiveAssemblyOverHttp) {
   port_ = p->port();
   ASSERT_GT(port_, 0) << p->err();
   // add: the task entry as JSON (a YAML flow mapping too), or on the shell's line.
-  const HttpResponse robot = http(
-      port_, HttpRequest{"POST", "/api/command", kOperator,
-                         R"({"verb": "add", "args": [{"name": "robot", "module": "robot_torque", "period": "1ms"}]})"});
+  HttpRequest add_robot{"POST", "/api/command", kOperator};
+  add_robot.body = R"({"verb": "add", "args": [{"name": "robot", "module": "robot_torque", "period": "1ms"}]})";
+  const HttpResponse robot = http(port_, add_robot);
   EXPECT_REPLY(robot, 200);
   EXPECT_EQ(body_of(robot)["task"], "robot");
   EXPECT_REPLY(run("add {name: traj, module: joint_traj_gen, period: 1ms, criticality: soft}"), 200);
