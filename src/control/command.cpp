@@ -42,6 +42,15 @@ constexpr std::array kVerbs{
     VerbSpec{Verb::kStats, "stats", 0, 1, "stats [TASK]", "the timing table, or one task's profile (histograms)"},
     VerbSpec{Verb::kQuit, "quit", 0, 0, "quit", "stop the subsystem cleanly (every task: off, then kill)"},
     VerbSpec{Verb::kHelp, "help", 0, 0, "help", "this list"},
+    VerbSpec{Verb::kAdd, "add", 1, 1, "add {name: T, module: M, ...}",
+             "add a task (NOT-CREATED), written as in the file's tasks:, while no task is created"},
+    VerbSpec{Verb::kDefine, "define", 1, kMany, "define CONFIG TASK..",
+             "define a configuration (new, or one that is not on) as these tasks"},
+    VerbSpec{Verb::kVerify, "verify", 1, 1, "verify CONFIG",
+             "check a configuration (eq. 1, eq. 2, sizes) without switching: what is missing or doubled"},
+    VerbSpec{Verb::kRemove, "remove", 1, 1, "remove TASK", "remove a task that no configuration uses"},
+    VerbSpec{Verb::kSave, "save", 0, 1, "save [FILE]",
+             "the subsystem as a file that chimera verify accepts (to FILE, or as the reply)"},
 };
 
 constexpr std::array<VerbHelp, kVerbs.size()> make_help() {
@@ -119,6 +128,15 @@ Result<Command> parse_command(std::string_view line) {
 
   Command command;
   command.verb = spec->verb;
+  if (command.verb == Verb::kAdd) {
+    // The task entry is YAML, blanks and all: the rest of the line after the verb is one argument.
+    std::string_view rest = line.substr(line.find(words.front()) + words.front().size());
+    while (!rest.empty() && is_space(rest.front())) rest.remove_prefix(1);
+    while (!rest.empty() && is_space(rest.back())) rest.remove_suffix(1);
+    if (rest.empty()) return make_error(Errc::kInvalidInput, arity_message(*spec));
+    command.args.emplace_back(rest);
+    return command;
+  }
   command.args.assign(std::make_move_iterator(words.begin() + 1), std::make_move_iterator(words.end()));
   if (command.args.size() < spec->min_args || command.args.size() > spec->max_args)
     return make_error(Errc::kInvalidInput, arity_message(*spec));

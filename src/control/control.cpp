@@ -8,23 +8,14 @@
 
 #include "chimera/control/task_profile.hpp"
 #include "chimera/control/timing_table.hpp"
+#include "reply_text.hpp"
 
 namespace chimera {
 
 namespace {
 
-Reply refused(std::string message) {
-  Reply r;
-  r.ok = false;
-  r.text = std::move(message) + "\n";
-  return r;
-}
-
-Reply said(std::string text) {
-  Reply r;
-  r.text = std::move(text);
-  return r;
-}
+using control_detail::refused;
+using control_detail::said;
 
 std::string format_values(std::string_view variable, const std::vector<double>& values) {
   return fmt::format("{} = [{}]\n", variable, fmt::join(values, ", "));
@@ -96,6 +87,11 @@ Reply Control::execute(const Command& command) {
         return r;
       }
       case Verb::kHelp: return said(help_text());
+      case Verb::kAdd:
+      case Verb::kDefine:
+      case Verb::kVerify:
+      case Verb::kRemove:
+      case Verb::kSave: return assemble(command);
     }
   } catch (const std::exception& e) {
     return refused(fmt::format("{}: internal error: {}", verb_name(command.verb), e.what()));

@@ -6,18 +6,15 @@
 
 #include <unistd.h>
 
-#include <atomic>
 #include <mutex>
+#include <shared_mutex>
+#include <utility>
 
 #include <fmt/format.h>
 
 #include "chimera/svt/global_table.hpp"
 #include "chimera/svt/value_codec.hpp"
-#include "exec/event_log.hpp"
-#include "exec/executive.hpp"
-#include "exec/task_set.hpp"
-#include "reconfig/reconfiguration.hpp"
-#include "reconfig/request_board.hpp"
+#include "subsystem_impl.hpp"
 #include "subsystem_test_access.hpp"
 
 namespace chimera {
@@ -38,44 +35,66 @@ std::vector<std::string> configuration_names(const SubsystemSpec& spec) {
 
 }  // namespace
 
-// Members in the order they are made; each refers only to those above it.
-struct Subsystem::Impl {
-  SubsystemSpec spec;  // the resolution points into this copy, which never moves
-  RunOptions options;
-  Resolution resolution;
-  std::unique_ptr<GlobalTable> table;
-  std::unique_ptr<SubsystemRequestBoard> requests;
-  std::unique_ptr<TaskSet> tasks;
-  std::unique_ptr<EventLog> events;
-  std::unique_ptr<Executive> executive;
-  std::unique_ptr<Reconfiguration> reconfiguration;
-  // Signals, switches, set and stop, one at a time; never taken by a task's thread. Queries
-  // (snapshot, events, get, the flag) do not take it: they answer while a switch is under way.
-  mutable std::mutex ops_mutex;
-  // The table's lifetime for the queries that read it without ops_mutex (get, the flag): stop()
-  // takes it to remove the table.
-  mutable std::mutex table_mutex;
-  std::atomic<bool> stopped{false};  // written under ops_mutex; read by queries on their own (seq_cst: rare, simplest)
-  // Per task, what the operator and the run need to know beyond its state, written under
-  // ops_mutex and read by queries that do not take it (notes_mutex):
-  // which of its failures a clear (or a kill) took it out of ERROR from, so that status tells a
-  // past error from the present state;
-  struct ErrorEnd {
-    std::uint64_t failure = 0;  // TaskFailure::number; 0: none ended yet
-    Signal by = Signal::kClear;
-    std::int64_t at_ns = 0;
-  };
-  // and what its module reported when a kill found a fault (whole: an event's text is bounded).
-  mutable std::mutex notes_mutex;
-  std::vector<ErrorEnd> error_ends;
-  std::vector<std::string> kill_faults;
+Result<void> check_task_cpus(const SubsystemSpec& spec) {
+  const long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
+  for (const auto& t : spec.tasks)
+    if (t.cpu && *t.cpu >= ncpu)
+      return make_error(Errc::kInvalidInput, fmt::format("{}:{}: tasks.{}.cpu: cpu {} does not exist on this machine "
+                                                         "({} CPUs)",
+                                                         spec.file, t.loc.line, t.name, *t.cpu, ncpu));
+  return {};
+}
 
-  void note_kill(std::size_t task, const Result<void>& killed) {
-    if (killed || killed.error().code != Errc::kModuleFault) return;
-    std::lock_guard<std::mutex> notes(notes_mutex);
-    kill_faults[task] = killed.error().message;
+Result<void> Subsystem::Impl::build_runtime(const std::string& configuration, std::int64_t start_ns) {
+  Impl& m = *this;
+  const ConfigurationSpec* config = m.spec.find_configuration(configuration);
+  if (config == nullptr)
+    return make_error(Errc::kNotFound, fmt::format("{}: no configuration named '{}'", m.spec.file, configuration));
+  Resolution fresh = resolve_subsystem(m.spec, *m.registry);
+  auto violations = verify_subsystem(fresh, configuration);
+  if (!violations.empty())
+    return make_error(Errc::kIllegal, fmt::format("{}: configuration '{}' is not legal:\n{}", m.spec.file,
+                                                  configuration, join_lines(violations)));
+
+  auto created = GlobalTable::create(m.spec.name + m.options.shm_suffix, fresh.subsystem.variables);
+  if (!created) return created.error();
+  m.resolution = std::move(fresh);
+  m.table = std::make_unique<GlobalTable>(std::move(*created));
+  // Constants known up front (the file's and the out-consts modules declare) are in the table
+  // before any init, so that an in-const reads its value whatever order tasks are spawned in.
+  for (const auto& [name, values] : m.resolution.subsystem.constant_values) {
+    if (auto v = m.table->find(name)) {
+      auto bytes = encode_values(m.table->shape(*v), values);
+      if (bytes) m.table->write(*v, bytes->data());
+    }
   }
-};
+
+  const ResolvedSubsystem& resolved = m.resolution.subsystem;
+  m.requests = std::make_unique<SubsystemRequestBoard>(configuration_names(m.spec), resolved.tasks.size());
+  m.tasks = std::make_unique<TaskSet>(resolved, *m.table, m.requests.get());
+  m.events = std::make_unique<EventLog>(m.tasks->size());
+  {
+    std::lock_guard<std::mutex> notes(m.notes_mutex);
+    m.error_ends.assign(m.tasks->size(), {});
+    m.kill_faults.assign(m.tasks->size(), {});
+    m.removed.assign(m.tasks->size(), false);
+  }
+  for (Task* t : m.tasks->pointers()) t->set_rt_check(m.options.rt_check);
+  ExecutiveSetup setup;
+  setup.clock = m.options.clock;
+  setup.realtime_priorities = m.options.realtime_priorities;
+  setup.measure_cpu_time = m.options.measure_cpu_time;
+  setup.subsystem = &resolved;
+  setup.table = m.table.get();
+  setup.tasks = m.tasks->pointers();
+  setup.configuration = config->tasks;
+  setup.events = m.events.get();
+  setup.start_ns = start_ns;
+  m.executive = make_executive(std::move(setup));
+  m.reconfiguration = std::make_unique<Reconfiguration>(resolved, configuration, *m.requests, *m.tasks,
+                                                        *m.executive, *m.table, *m.events);
+  return {};
+}
 
 Subsystem::Subsystem() : impl_(std::make_unique<Impl>()) {}
 Subsystem::~Subsystem() { stop(); }
@@ -90,50 +109,9 @@ Result<std::unique_ptr<Subsystem>> Subsystem::create(const SubsystemSpec& spec, 
   const ConfigurationSpec* start_config = m.spec.find_configuration(start);
   if (start_config == nullptr)
     return make_error(Errc::kNotFound, fmt::format("{}: no configuration named '{}'", spec.file, start));
-  const long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
-  for (const auto& t : m.spec.tasks)
-    if (t.cpu && *t.cpu >= ncpu)
-      return make_error(Errc::kInvalidInput, fmt::format("{}:{}: tasks.{}.cpu: cpu {} does not exist on this machine "
-                                                         "({} CPUs)",
-                                                         spec.file, t.loc.line, t.name, *t.cpu, ncpu));
-
-  m.resolution = resolve_subsystem(m.spec, registry);
-  auto violations = verify_subsystem(m.resolution, start);
-  if (!violations.empty())
-    return make_error(Errc::kIllegal, fmt::format("{}: configuration '{}' is not legal:\n{}", spec.file, start,
-                                                  join_lines(violations)));
-
-  auto table = GlobalTable::create(m.spec.name + m.options.shm_suffix, m.resolution.subsystem.variables);
-  if (!table) return table.error();
-  m.table = std::make_unique<GlobalTable>(std::move(*table));
-  // Constants known up front (the file's and the out-consts modules declare) are in the table
-  // before any init, so that an in-const reads its value whatever order tasks are spawned in.
-  for (const auto& [name, values] : m.resolution.subsystem.constant_values) {
-    if (auto v = m.table->find(name)) {
-      auto bytes = encode_values(m.table->shape(*v), values);
-      if (bytes) m.table->write(*v, bytes->data());
-    }
-  }
-
-  const ResolvedSubsystem& resolved = m.resolution.subsystem;
-  m.requests = std::make_unique<SubsystemRequestBoard>(configuration_names(m.spec), resolved.tasks.size());
-  m.tasks = std::make_unique<TaskSet>(resolved, *m.table, m.requests.get());
-  m.events = std::make_unique<EventLog>(m.tasks->size());
-  m.error_ends.resize(m.tasks->size());
-  m.kill_faults.resize(m.tasks->size());
-  for (Task* t : m.tasks->pointers()) t->set_rt_check(m.options.rt_check);
-  ExecutiveSetup setup;
-  setup.clock = m.options.clock;
-  setup.realtime_priorities = m.options.realtime_priorities;
-  setup.measure_cpu_time = m.options.measure_cpu_time;
-  setup.subsystem = &resolved;
-  setup.table = m.table.get();
-  setup.tasks = m.tasks->pointers();
-  setup.configuration = start_config->tasks;
-  setup.events = m.events.get();
-  m.executive = make_executive(std::move(setup));
-  m.reconfiguration =
-      std::make_unique<Reconfiguration>(resolved, start, *m.requests, *m.tasks, *m.executive, *m.table, *m.events);
+  if (auto cpus = check_task_cpus(m.spec); !cpus) return cpus.error();
+  m.registry = &registry;
+  if (auto built = m.build_runtime(start, 0); !built) return built.error();
   return s;
 }
 
@@ -158,19 +136,28 @@ Result<void> Subsystem::start() {
   }
   // From now on the switches tasks ask for are carried out (by a service thread on the real clock,
   // at the very instant on the virtual one), under the same lock as the operator's.
+  serve_requests();
+  return {};
+}
+
+void Subsystem::serve_requests() {
+  Impl& m = *impl_;
+  {
+    std::lock_guard<std::mutex> lock(m.ops_mutex);
+    m.serving = true;
+  }
   m.executive->serve(ServiceHooks{&m.requests->bell(), [this] {
                                     Impl& self = *impl_;
                                     std::lock_guard<std::mutex> lock(self.ops_mutex);
                                     if (!self.stopped) self.reconfiguration->serve_requests();
                                   }});
-  return {};
 }
 
 Result<void> Subsystem::signal(std::string_view task, Signal signal) {
   Impl& m = *impl_;
   std::lock_guard<std::mutex> lock(m.ops_mutex);
   if (m.stopped) return make_error(Errc::kState, "the subsystem is stopped");
-  const auto i = m.tasks->index_of(task);
+  const auto i = m.live_index(task);
   if (!i) return make_error(Errc::kNotFound, fmt::format("no task named '{}'", task));
   const bool was_in_error = (*m.tasks)[*i].state() == TaskState::kError;
   auto r = m.executive->signal(*i, signal);
@@ -185,6 +172,8 @@ Result<void> Subsystem::signal(std::string_view task, Signal signal) {
 }
 
 void Subsystem::run_for(std::int64_t ns) {
+  // No runtime lock: the live assembly's add, which replaces the executive, comes from the thread
+  // that drives the commands, as this does (and the virtual clock's run_for takes ops_mutex).
   Impl& m = *impl_;
   if (m.stopped) return;
   m.executive->run_for(ns);
@@ -223,23 +212,26 @@ void Subsystem::stop() {
   m.executive->shutdown();
   m.stopped = true;
   m.events->collect(*m.tasks);  // what off and kill reported stays readable, as do the tasks' figures
-  std::lock_guard<std::mutex> table(m.table_mutex);
+  std::unique_lock<std::shared_mutex> runtime(m.runtime_mutex);
   m.table.reset();  // unlinks the shared memory
 }
 
-std::int64_t Subsystem::now_ns() const { return impl_->executive->now_ns(); }
-ClockKind Subsystem::clock() const { return impl_->executive->clock(); }
+std::int64_t Subsystem::now_ns() const {
+  std::shared_lock<std::shared_mutex> lock(impl_->runtime_mutex);  // an add replaces the executive
+  return impl_->executive->now_ns();
+}
+ClockKind Subsystem::clock() const { return impl_->options.clock; }
 const SubsystemSpec& Subsystem::spec() const { return impl_->spec; }
 const ResolvedSubsystem& Subsystem::resolved() const { return impl_->resolution.subsystem; }
 
 bool Subsystem::illegal_configuration() const {
-  std::lock_guard<std::mutex> lock(impl_->table_mutex);  // the table goes at stop
+  std::shared_lock<std::shared_mutex> lock(impl_->runtime_mutex);  // the table goes at stop
   return impl_->table && impl_->table->illegal_configuration();
 }
 
 Result<std::vector<double>> Subsystem::get(std::string_view variable) const {
   const Impl& m = *impl_;
-  std::lock_guard<std::mutex> lock(m.table_mutex);  // the table goes at stop
+  std::shared_lock<std::shared_mutex> lock(m.runtime_mutex);  // the table goes at stop
   if (m.table == nullptr) return make_error(Errc::kState, "the subsystem is stopped");
   const auto v = m.table->find(variable);
   if (!v) return make_error(Errc::kNotFound, fmt::format("no state variable named '{}'", variable));
@@ -274,9 +266,11 @@ Result<void> Subsystem::set(std::string_view variable, const std::vector<double>
 
 std::vector<TaskSnapshot> Subsystem::snapshot() const {
   Impl& m = *impl_;
+  std::shared_lock<std::shared_mutex> runtime(m.runtime_mutex);  // an add replaces the tasks
   m.events->collect(*m.tasks);  // so that last_error is current whether or not anyone drains events
   std::vector<TaskSnapshot> out;
   for (std::size_t i = 0; i < m.tasks->size(); ++i) {
+    if (m.is_removed(i)) continue;
     const Task& t = (*m.tasks)[i];
     const TaskFailure failure = m.events->last_failure(i);
     TaskSnapshot snap;
@@ -303,8 +297,15 @@ std::vector<TaskSnapshot> Subsystem::snapshot() const {
 
 std::vector<Event> Subsystem::drain_events() {
   Impl& m = *impl_;
+  std::shared_lock<std::shared_mutex> runtime(m.runtime_mutex);  // an add replaces the log
   m.events->collect(*m.tasks);  // the log's own lock makes it the rings' one consumer
-  return m.events->drain();
+  std::vector<Event> out;
+  {
+    std::lock_guard<std::mutex> notes(m.notes_mutex);
+    out = std::exchange(m.earlier_events, {});
+  }
+  for (auto& e : m.events->drain()) out.push_back(std::move(e));
+  return out;
 }
 
 GlobalTable& SubsystemTestAccess::table(Subsystem& subsystem) {
@@ -312,10 +313,22 @@ GlobalTable& SubsystemTestAccess::table(Subsystem& subsystem) {
   return *subsystem.impl_->table;
 }
 
-bool Subsystem::hard_task_failed() const { return impl_->tasks && impl_->tasks->hard_task_failed(); }
+bool Subsystem::hard_task_failed() const {
+  const Impl& m = *impl_;
+  std::shared_lock<std::shared_mutex> runtime(m.runtime_mutex);
+  return m.earlier_hard_failure || (m.tasks && m.tasks->hard_task_failed());
+}
 
 std::vector<std::string> Subsystem::faults() const {
   const Impl& m = *impl_;
+  std::shared_lock<std::shared_mutex> runtime(m.runtime_mutex);
+  std::vector<std::string> out = m.earlier_faults;
+  for (auto& line : m.runtime_faults()) out.push_back(std::move(line));
+  return out;
+}
+
+std::vector<std::string> Subsystem::Impl::runtime_faults() const {
+  const Impl& m = *this;
   std::vector<std::string> out;
   if (!m.tasks) return out;
   m.events->collect(*m.tasks);

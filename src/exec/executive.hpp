@@ -40,6 +40,9 @@ struct ExecutiveSetup {
   std::vector<Task*> tasks;                // every task of the file, in file order
   std::vector<std::string> configuration;  // the tasks that start: the first plan (MUF's critical set)
   EventLog* events = nullptr;              // where the executive's own events go (a job overdue)
+  /// The time the executive's clock starts at: 0 for a new subsystem; for one rebuilt by the
+  /// live assembly (a task added), the time its clock had reached, so that time goes on.
+  std::int64_t start_ns = 0;
 };
 
 /// A switch's commit (docs/reconfiguration.md).

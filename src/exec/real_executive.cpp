@@ -112,7 +112,7 @@ RealExecutive::RealExecutive(ExecutiveSetup setup)
       order_(analysis::compute_release_order(subsystem_)),
       plan_(make_schedule_plan(subsystem_, order_, subsystem_cpus(*subsystem_.spec), setup.configuration)),
       cpus_(plan_.cpu),
-      epoch_ns_(monotonic_ns()),
+      epoch_ns_(monotonic_ns() - setup.start_ns),
       realtime_(setup.realtime_priorities) {
   prepare_realtime_process(realtime_);
   for (Task* t : tasks_) {

@@ -21,7 +21,8 @@ VirtualExecutive::VirtualExecutive(ExecutiveSetup setup)
       order_(analysis::compute_release_order(subsystem_)),
       plan_(make_schedule_plan(subsystem_, order_, subsystem_cpus(*subsystem_.spec), setup.configuration)),
       cpus_(plan_.cpu),
-      slots_(tasks_.size()) {
+      slots_(tasks_.size()),
+      now_ns_(setup.start_ns) {
   for (Task* t : tasks_) t->set_virtual_clock(true);
   std::vector<int> cpus;
   for (const int c : plan_.cpu)

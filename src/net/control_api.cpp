@@ -63,7 +63,7 @@ json status_json(const Subsystem& subsystem) {
   json tasks = json::array();
   for (const auto& t : subsystem.snapshot()) tasks.push_back(task_json(t));
   json configurations = json::array();
-  for (const auto& c : subsystem.spec().configurations) configurations.push_back(c.name);
+  for (auto& name : subsystem.configurations()) configurations.push_back(std::move(name));
   return json{{"subsystem", subsystem.spec().name},
               {"clock", subsystem.clock() == ClockKind::kVirtual ? "virtual" : "real"},
               {"now_ns", subsystem.now_ns()},
@@ -122,6 +122,8 @@ std::variant<std::string, std::string> command_line(const json& doc) {
   if (doc.contains("args")) {
     const json& args = doc["args"];
     if (!args.is_array()) return fail("args: an array of words and numbers");
+    // add's one argument is a task entry: a JSON object is also a YAML flow mapping.
+    if (line == "add" && args.size() == 1 && args[0].is_object()) return Out(std::in_place_index<0>, "add " + dump(args[0]));
     for (std::size_t i = 0; i < args.size(); ++i) {
       const json& a = args[i];
       std::string word;
@@ -140,6 +142,39 @@ std::variant<std::string, std::string> command_line(const json& doc) {
   return Out(std::in_place_index<0>, std::move(line));
 }
 
+json violations_json(const std::vector<Violation>& violations) {
+  json out = json::array();
+  for (const auto& v : violations)
+    out.push_back(json{{"rule", v.rule},
+                       {"variable", v.variable},
+                       {"tasks", v.tasks},
+                       {"reason", violation_reason(v)},
+                       {"message", v.message}});
+  return out;
+}
+
+// What the live assembly's verbs add to their reply, read right after the command.
+void assembly_json(const Command& c, const Subsystem& subsystem, json& more) {
+  switch (c.verb) {
+    case Verb::kAdd: more["task"] = subsystem.spec().tasks.back().name; break;
+    case Verb::kDefine:
+    case Verb::kVerify: {
+      auto violations = subsystem.verify_configuration(c.args.at(0));
+      if (!violations) return;
+      more["configuration"] = c.args.at(0);
+      more["legal"] = violations->empty();
+      more["violations"] = violations_json(*violations);
+      break;
+    }
+    case Verb::kRemove: more["task"] = c.args.at(0); break;
+    case Verb::kSave: {
+      if (auto text = subsystem.save_yaml()) more["yaml"] = *text;
+      break;
+    }
+    default: break;
+  }
+}
+
 }  // namespace
 
 bool verb_needs_operator(Verb verb) {
@@ -147,7 +182,9 @@ bool verb_needs_operator(Verb verb) {
     case Verb::kStatus:
     case Verb::kStats:
     case Verb::kGet:
-    case Verb::kHelp: return false;
+    case Verb::kHelp:
+    case Verb::kVerify:
+    case Verb::kSave: return false;  // save over the network only replies with the file
     default: return true;  // signals, switch, set, wait (time passes on the virtual clock), quit
   }
 }
@@ -237,6 +274,10 @@ ApiResponse ControlApi::command(Role role, std::string_view body) {
   if (verb_needs_operator(c.verb) && role != Role::kOperator)
     return error(403, "forbidden", fmt::format("{}: needs an operator's token; this one is a viewer's", verb));
   if (c.verb == Verb::kWait) return wait(c);
+  if (c.verb == Verb::kSave && !c.args.empty())
+    return error(400, "bad_command",
+                 "save FILE writes on the server's machine: over the network send save alone; the reply's yaml is the "
+                 "file");
 
   auto [r, extra] = gate_.exclusive([&](Control& control, Subsystem& subsystem) {
     Reply done = control.execute(c);
@@ -244,6 +285,7 @@ ApiResponse ControlApi::command(Role role, std::string_view body) {
     if (done.ok && c.verb == Verb::kStatus) more["status"] = status_json(subsystem);
     if (done.ok && (c.verb == Verb::kSwitch || c.verb == Verb::kStatus))
       more["configuration"] = subsystem.configuration();
+    if (done.ok) assembly_json(c, subsystem, more);
     if (done.ok && c.verb == Verb::kStats) {
       const auto tasks = subsystem.snapshot();
       json all = json::parse(stats_json(tasks, subsystem.clock(), subsystem.switches().size()));

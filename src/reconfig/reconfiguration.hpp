@@ -38,6 +38,9 @@ class Reconfiguration {
 
   [[nodiscard]] const std::string& configuration() const noexcept { return configuration_; }
   [[nodiscard]] const std::vector<SwitchRecord>& history() const noexcept { return history_; }
+  /// The switches of an earlier runtime of the same subsystem (rebuilt by the live assembly),
+  /// kept before this one's own. Not real-time safe.
+  void carry_history(std::vector<SwitchRecord> earlier) { history_ = std::move(earlier); }
 
  private:
   /// Creates `to_spawn` in the background, publishing nothing; kills them again if one fails.

@@ -26,12 +26,19 @@ enum class Verb {
   kStats,
   kQuit,
   kHelp,
+  // The live assembly (docs/control-api.md, "Live assembly").
+  kAdd,
+  kDefine,
+  kVerify,
+  kRemove,
+  kSave,
 };
 
 /// The word that names `verb` on the command line ("status", "on", ...).
 std::string_view verb_name(Verb verb);
 
-/// One parsed command. `args` are the words after the verb; for `set` the numbers are also in
+/// One parsed command. `args` are the words after the verb (for `add`, the one task entry: the
+/// rest of the line, blanks and all); for `set` the numbers are also in
 /// `values`, for `wait` the duration is in `duration_ns`, so nobody parses them twice.
 struct Command {
   Verb verb = Verb::kHelp;

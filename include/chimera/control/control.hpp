@@ -41,9 +41,20 @@ class Control {
   Reply signal_tasks(Signal signal, const std::vector<std::string>& names);
   Reply get(const std::string& variable) const;
   Reply set(const std::string& variable, const std::vector<double>& values);
+  // The live assembly's verbs (assembly_commands.cpp).
+  Reply assemble(const Command& command);
+  Reply add(const std::string& entry);
+  Reply define(const std::vector<std::string>& args);
+  Reply verify(const std::string& configuration) const;
+  Reply remove(const std::string& task);
+  Reply save(const std::vector<std::string>& args) const;
 
   Subsystem& subsystem_;
 };
+
+/// Why a configuration is not legal, as the set difference in words: "tau_r has no producer (read
+/// by pid)", "theta_d has more than one producer (ik, integ)"; other rules as verification says.
+std::string violation_reason(const Violation& violation);
 
 /// The state a task must be in to accept `signal`, for messages ("OFF", "OFF, ON or ERROR").
 std::string_view required_state_text(Signal signal);

@@ -59,8 +59,12 @@ struct TaskSnapshot {
 
 class Subsystem {
  public:
+  /// What it is made of: opaque here, defined in src/control (the live assembly's files share it).
+  struct Impl;
+
   /// Resolves and verifies the file, creates the global table in shared memory. Refuses an
   /// illegal start configuration. Not real-time safe.
+  /// `registry` outlives the subsystem (the live assembly resolves added tasks with it).
   static Result<std::unique_ptr<Subsystem>> create(const SubsystemSpec& spec, const Registry& registry,
                                                    RunOptions options);
   ~Subsystem();
@@ -98,10 +102,39 @@ class Subsystem {
   /// Time since start on the subsystem's clock.
   [[nodiscard]] std::int64_t now_ns() const;
   [[nodiscard]] ClockKind clock() const;
+  /// The subsystem's model; the live assembly changes it (read it from the thread that drives
+  /// the commands).
   [[nodiscard]] const SubsystemSpec& spec() const;
   [[nodiscard]] const ResolvedSubsystem& resolved() const;
   /// Whether the illegal-configuration flag is up now (paper 3.4). Any thread.
   [[nodiscard]] bool illegal_configuration() const;
+
+  // The live assembly (docs/control-api.md, "Live assembly"), what ros2_control users do with
+  // load, configure and switch. Each refuses, changing nothing, what it cannot carry out, with one
+  // line saying why. Call them from the thread that drives the commands (the command gate), as
+  // run_for(). Not real-time safe.
+
+  /// Adds a task to the subsystem, NOT-CREATED: `entry` is one entry of a file's `tasks:` list as
+  /// a YAML flow mapping, `{name: pid, module: pid_joint, period: 1ms, params: {kp: 5}}`, checked
+  /// as the loader checks a file. The running executive is made anew for the larger set of tasks,
+  /// which it can only be while no task is created: refused while any task is OFF, ON or ERROR.
+  /// Returns the new task's name.
+  Result<std::string> add_task(std::string_view entry);
+  /// Defines configuration `name` (new, or one that is not on) as `tasks`, whether legal or not:
+  /// verify_configuration() says, and switch_to() refuses an illegal one.
+  Result<void> define_configuration(std::string_view name, const std::vector<std::string>& tasks);
+  /// The violations of configuration `name` (the paper's equations 1 and 2 and the size rule);
+  /// empty if it is legal. Never switches.
+  [[nodiscard]] Result<std::vector<Violation>> verify_configuration(std::string_view name) const;
+  /// Removes a task that no configuration (and no `requests:` entry) names; one that is created
+  /// is killed first, one that is ON is refused.
+  Result<void> remove_task(std::string_view name);
+  /// The subsystem as a subsystem file, its `start:` the configuration on now: what `chimera
+  /// verify` accepts and `chimera run` starts as this subsystem. Refused while a configuration is
+  /// illegal or there is no task (a file has at least one).
+  [[nodiscard]] Result<std::string> save_yaml() const;
+  /// The names of the configurations, in definition order. Any thread.
+  [[nodiscard]] std::vector<std::string> configurations() const;
 
   /// The current value of a variable, converted to doubles; and a write by the operator,
   /// refused if an ON task produces the variable.
@@ -123,7 +156,8 @@ class Subsystem {
  private:
   friend class SubsystemTestAccess;  // tests: the table itself (src/control/subsystem_test_access.hpp)
   Subsystem();
-  struct Impl;
+  /// From now on the switches tasks ask for are carried out.
+  void serve_requests();
   std::unique_ptr<Impl> impl_;
 };
 

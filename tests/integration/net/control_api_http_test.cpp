@@ -173,7 +173,10 @@ TEST_F(ControlApiHttpTest, EveryShellCommandOverHttp) {
   for (const auto& c : commands) roles[c["verb"].get<std::string>()] = c["role"].get<std::string>();
   EXPECT_EQ(roles["status"], "viewer");
   EXPECT_EQ(roles["on"], "operator");
-  EXPECT_EQ(roles.size(), 13U);
+  EXPECT_EQ(roles["add"], "operator");  // live assembly changes the subsystem
+  EXPECT_EQ(roles["verify"], "viewer");  // checks, changes nothing
+  EXPECT_EQ(roles["save"], "viewer");    // over the network save only replies with the file
+  EXPECT_EQ(roles.size(), 18U);
 
   // quit stops the subsystem cleanly: the process ends with the timing table.
   r = run("quit");
@@ -490,6 +493,55 @@ TEST_F(ControlApiHttpTest, ServeStartsAnEmptySubsystem) {
   EXPECT_TRUE(contains(page.header("content-type"), "text/html"));
   EXPECT_TRUE(contains(page.body, "/api/"));
   EXPECT_EQ(http(port_, HttpRequest{"GET", "/nosuch", ""}).status, 404);
+  EXPECT_REPLY(run("quit"), 200);
+  EXPECT_EQ(p->wait_exit(), 0) << p->err();
+}
+
+TEST_F(ControlApiHttpTest, LiveAssemblyOverHttp) {
+  auto p = std::make_unique<ChimeraProcess>(
+      dir_, std::vector<std::string>{"serve", "--listen", "127.0.0.1:0", "--token-file", token_file()});
+  port_ = p->port();
+  ASSERT_GT(port_, 0) << p->err();
+  // add: the task entry as JSON (a YAML flow mapping too), or on the shell's line.
+  HttpRequest add_robot{"POST", "/api/command", kOperator};
+  add_robot.body = R"({"verb": "add", "args": [{"name": "robot", "module": "robot_torque", "period": "1ms"}]})";
+  const HttpResponse robot = http(port_, add_robot);
+  EXPECT_REPLY(robot, 200);
+  EXPECT_EQ(body_of(robot)["task"], "robot");
+  EXPECT_REPLY(run("add {name: traj, module: joint_traj_gen, period: 1ms, criticality: soft}"), 200);
+  EXPECT_REPLY(run("add {name: traj, module: joint_traj_gen, period: 1ms}"), 409);  // already there
+  EXPECT_REPLY(run("add {name: x, module: cpu_load}", kViewer), 403);
+  // define and verify: the set difference, and nothing switched.
+  const HttpResponse defined = run("define fig4 traj robot");
+  EXPECT_REPLY(defined, 200);
+  EXPECT_EQ(body_of(defined)["legal"], false);
+  const HttpResponse verified = run("verify fig4", kViewer);
+  EXPECT_REPLY(verified, 200);
+  const json v = body_of(verified);
+  EXPECT_EQ(v["legal"], false);
+  ASSERT_EQ(v["violations"].size(), 1U) << verified.body;
+  EXPECT_EQ(v["violations"][0]["rule"], 2);
+  EXPECT_EQ(v["violations"][0]["variable"], "tau_r");
+  EXPECT_EQ(v["violations"][0]["reason"], "tau_r has no producer (read by robot)");
+  EXPECT_REPLY(run("switch fig4"), 409);
+  EXPECT_REPLY(run("add {name: pid, module: pid_joint, period: 1ms}"), 200);
+  EXPECT_REPLY(run("add {name: spare, module: cpu_load, period: 10ms}"), 200);
+  EXPECT_REPLY(run("define fig4 traj pid robot"), 200);
+  EXPECT_EQ(body_of(run("verify fig4"))["legal"], true);
+  EXPECT_REPLY(run("switch fig4"), 200);
+  EXPECT_REPLY(run("wait 100ms"), 200);
+  EXPECT_EQ(states(port_)["pid"], "ON");
+  EXPECT_REPLY(run("remove pid"), 409);
+  EXPECT_REPLY(run("remove spare"), 200);
+  EXPECT_EQ(states(port_).count("spare"), 0U);
+  // save: over the network the reply carries the file, which chimera verify accepts.
+  EXPECT_REPLY(run("save /tmp/anything.yaml"), 400);
+  const HttpResponse saved = run("save", kViewer);
+  EXPECT_REPLY(saved, 200);
+  const std::string path = dir_.file("saved.yaml");
+  write_text(path, body_of(saved)["yaml"].get<std::string>());
+  const auto checked = run_chimera(dir_, "verify " + path);
+  EXPECT_EQ(checked.exit_code, 0) << checked.out << checked.err;
   EXPECT_REPLY(run("quit"), 200);
   EXPECT_EQ(p->wait_exit(), 0) << p->err();
 }
