@@ -17,6 +17,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "chimera/core/invariant.hpp"
 #include "chimera/exec/clock.hpp"
 #include "futex.hpp"
 #include "priority_dispatcher.hpp"
@@ -109,10 +110,11 @@ RealExecutive::RealExecutive(ExecutiveSetup setup)
       table_(setup.table),
       events_(setup.events),
       tasks_(std::move(setup.tasks)),
+      hosted_(std::move(setup.hosted)),
       order_(analysis::compute_release_order(subsystem_)),
       plan_(make_schedule_plan(subsystem_, order_, subsystem_cpus(*subsystem_.spec), setup.configuration)),
       cpus_(plan_.cpu),
-      epoch_ns_(monotonic_ns() - setup.start_ns),
+      epoch_ns_(setup.epoch_ns != 0 ? setup.epoch_ns : monotonic_ns() - setup.start_ns),
       realtime_(setup.realtime_priorities) {
   prepare_realtime_process(realtime_);
   for (Task* t : tasks_) {
@@ -159,11 +161,14 @@ void RealExecutive::link_workers() {
       return v && std::ranges::find(i.out_vars, static_cast<int>(*v)) != i.out_vars.end();
     });
   };
+  // Only tasks of one process wait for or wake each other: a task of another process has a
+  // Worker here that never runs (docs/processes.md).
   for (std::size_t i = 0; i < workers_.size(); ++i) {
     for (const int p : order.predecessors[i])
-      workers_[i]->predecessors.push_back(workers_[static_cast<std::size_t>(p)].get());
+      if (hosts(i) && hosts(static_cast<std::size_t>(p)))
+        workers_[i]->predecessors.push_back(workers_[static_cast<std::size_t>(p)].get());
     for (std::size_t j = 0; j < workers_.size(); ++j)
-      if (j != i && !workers_[j]->task->periodic() && reads_from(*workers_[j], *workers_[i]))
+      if (j != i && hosts(i) && hosts(j) && !workers_[j]->task->periodic() && reads_from(*workers_[j], *workers_[i]))
         workers_[i]->subscribers.push_back(workers_[j].get());
   }
 }
@@ -195,7 +200,8 @@ void RealExecutive::form_threads() {
                    [&](std::size_t a, std::size_t b) { return order.rank[a] < order.rank[b]; });
   for (const std::size_t i : by_rank) {
     Worker& w = *workers_[i];
-    const bool groups = w.dispatcher == nullptr && w.task->periodic();
+    // A task this process does not run never shares a thread: its state is another process's.
+    const bool groups = w.dispatcher == nullptr && w.task->periodic() && hosts(i);
     const auto key = std::tuple{w.cpu, w.fixed_priority, w.task->period_ns()};
     TaskThread* t = groups && shared.contains(key) ? shared[key] : nullptr;
     if (t == nullptr) {
@@ -217,10 +223,10 @@ void RealExecutive::shutdown() {
   if (stopped_at_ns_ >= 0) return;
   // The paper's two-step termination: every task off, then every task killed.
   for (std::size_t i = 0; i < workers_.size(); ++i)
-    if (tasks_[i]->state() == TaskState::kOn) (void)signal(i, Signal::kOff);
+    if (hosts(i) && tasks_[i]->state() == TaskState::kOn) (void)signal(i, Signal::kOff);
   for (std::size_t i = 0; i < workers_.size(); ++i) {
     Worker& w = *workers_[i];
-    if (w.thread->running && w.task->state() != TaskState::kNotCreated) (void)signal(i, Signal::kKill);
+    if (hosts(i) && w.thread->running && w.task->state() != TaskState::kNotCreated) (void)signal(i, Signal::kKill);
   }
   for (auto& t : threads_)
     if (t->running) pthread_join(t->handle, nullptr);  // its last member's kill ended it
@@ -340,6 +346,7 @@ Result<void> RealExecutive::post_all(const std::vector<std::size_t>& indices, co
 Result<void> RealExecutive::signal(std::size_t index, Signal sig) {
   std::lock_guard<std::mutex> lock(control_mutex_);
   if (stopped_at_ns_ >= 0) return make_error(Errc::kState, "the subsystem is stopped");
+  CHIMERA_INVARIANT(hosts(index), "RealExecutive::signal() to a task another process runs");
   Worker& w = *workers_[index];
   if (!w.thread->running) {
     if (sig != Signal::kSpawn) return w.task->apply(sig, now_ns());  // refused by the state table

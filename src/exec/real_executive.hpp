@@ -55,6 +55,8 @@ class RealExecutive final : public Executive {
   [[nodiscard]] const GlobalTable& table() const { return *table_; }
   /// The SCHED_FIFO priority task `index` starts at (its fixed priority under rm and dm).
   [[nodiscard]] int fixed_priority(std::size_t index) const;
+  /// Whether this process runs task `index` (ExecutiveSetup::hosted). Any thread.
+  [[nodiscard]] bool hosts(std::size_t index) const noexcept { return hosted_.empty() || hosted_[index]; }
   /// The absolute deadline (executive clock) of the job task `index` is running now, if it is
   /// running one with a deadline; it names the job. Any thread; wait-free.
   [[nodiscard]] std::optional<std::int64_t> running_deadline(std::size_t index) const noexcept;
@@ -85,6 +87,7 @@ class RealExecutive final : public Executive {
   GlobalTable* table_;
   EventLog* events_;
   std::vector<Task*> tasks_;
+  const std::vector<bool> hosted_;  // empty: every task
   analysis::ReleaseOrder order_;
   SchedulePlan plan_;
   const std::vector<int> cpus_;  // plan_.cpu as it was made: a switch never moves a task, so any thread may read it

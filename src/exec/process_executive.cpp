@@ -1,0 +1,229 @@
+#include "process_executive.hpp"
+
+#include <poll.h>
+#include <sys/eventfd.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <map>
+#include <mutex>
+#include <utility>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "event_log.hpp"
+
+namespace chimera {
+
+namespace {
+
+ProcessCommand command_for(ProcessCommandKind kind, std::size_t task, Signal signal = Signal::kSpawn) {
+  ProcessCommand c;
+  c.kind = kind;
+  c.signal = signal;
+  c.count = 1;
+  c.tasks[0] = static_cast<std::uint32_t>(task);
+  return c;
+}
+
+}  // namespace
+
+ProcessExecutive::ProcessExecutive(ExecutiveSetup setup)
+    : tasks_(setup.tasks),
+      events_(setup.events),
+      block_(setup.processes.block),
+      launch_{setup.processes.worker_program, setup.processes.worker_args, setup.processes.block->fd()} {
+  // One ModuleProcess per process name other than main, in order of first appearance.
+  std::map<std::string, int> index;
+  std::vector<bool> hosted(tasks_.size(), true);
+  std::vector<std::vector<std::size_t>> members;
+  std::vector<std::string> names;
+  owner_.assign(tasks_.size(), -1);
+  for (std::size_t i = 0; i < tasks_.size(); ++i) {
+    const std::string& name = tasks_[i]->spec().process;
+    if (name == kMainProcess) continue;
+    auto [it, added] = index.emplace(name, static_cast<int>(names.size()));
+    if (added) {
+      names.push_back(name);
+      members.emplace_back();
+    }
+    owner_[i] = it->second;
+    members[static_cast<std::size_t>(it->second)].push_back(i);
+    hosted[i] = false;
+  }
+  for (std::size_t k = 0; k < names.size(); ++k)
+    processes_.push_back(std::make_unique<ModuleProcess>(names[k], members[k]));
+  setup.hosted = std::move(hosted);
+  local_ = std::make_unique<RealExecutive>(std::move(setup));
+  // Before any worker starts: they take this epoch, so that every release is on one grid.
+  block_->set_epoch_ns(local_->epoch_ns());
+  wake_fd_ = ::eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK);
+  if (wake_fd_ < 0) spdlog::error("no eventfd for the process supervisor: a module process's end is seen late");
+  supervisor_ = std::thread([this] { supervise(); });
+}
+
+ProcessExecutive::~ProcessExecutive() {
+  shutdown();
+  if (wake_fd_ >= 0) ::close(wake_fd_);
+}
+
+ModuleProcess* ProcessExecutive::owner(std::size_t task) const {
+  const int k = owner_[task];
+  return k < 0 ? nullptr : processes_[static_cast<std::size_t>(k)].get();
+}
+
+Result<void> ProcessExecutive::signal(std::size_t task, Signal signal) {
+  ModuleProcess* p = owner(task);
+  if (p == nullptr) return local_->signal(task, signal);
+  if (stopped_) return make_error(Errc::kState, "the subsystem is stopped");
+  std::lock_guard<std::mutex> lock(p->mutex);
+  if (!p->running()) {
+    if (!p->ended.empty()) {
+      // Its process has ended: clear starts it again; kill destroys the task without one.
+      if (signal == Signal::kClear && tasks_[task]->state() == TaskState::kError) return restart(*p, task);
+      if (signal == Signal::kKill) {
+        (void)tasks_[task]->forget_lost_process();
+        return {};
+      }
+      return make_error(Errc::kState, fmt::format("{}: its process {} has ended ({}); clear starts it again",
+                                                  tasks_[task]->name(), p->name(), p->ended));
+    }
+    if (signal != Signal::kSpawn) return tasks_[task]->apply(signal, now_ns());  // refused: NOT CREATED
+    if (auto started = start(*p); !started) return started;
+  }
+  return send(*p, command_for(ProcessCommandKind::kSignal, task, signal));
+}
+
+Result<void> ProcessExecutive::start(ModuleProcess& p) {
+  auto started = p.start(launch_);
+  wake_supervisor();  // a new pidfd to watch
+  return started;
+}
+
+Result<void> ProcessExecutive::send(ModuleProcess& p, const ProcessCommand& command) {
+  auto r = p.command(command);
+  if (p.death_seen()) handle_end(p);
+  return r;
+}
+
+void ProcessExecutive::handle_end(ModuleProcess& p) {
+  if (!p.running()) return;
+  p.ended = p.reap();
+  const std::string reason = fmt::format("its process {} died ({})", p.name(), p.ended);
+  const std::int64_t now = now_ns();
+  for (const std::size_t i : p.tasks()) tasks_[i]->lose_process(reason.c_str(), now);
+  if (events_ != nullptr) events_->add(Event{now, "", fmt::format("process {} died ({})", p.name(), p.ended)});
+}
+
+Result<void> ProcessExecutive::restart(ModuleProcess& p, std::size_t task) {
+  if (auto started = start(p); !started) return started;  // the tasks stay in ERROR
+  p.ended.clear();
+  // Every task that existed before the end is made again in the new process: OFF, as a clear leaves it.
+  Result<void> outcome;
+  for (const std::size_t i : p.tasks()) {
+    if (!tasks_[i]->forget_lost_process()) continue;
+    auto spawned = send(p, command_for(ProcessCommandKind::kSignal, i, Signal::kSpawn));
+    if (!spawned && (outcome || i == task)) outcome = spawned;
+    if (!p.running()) break;  // it ended again at once
+  }
+  return outcome;
+}
+
+Result<void> ProcessExecutive::turn_on_together(const std::vector<std::size_t>& tasks) {
+  std::vector<std::size_t> local;
+  std::vector<std::vector<std::size_t>> remote(processes_.size());
+  for (const std::size_t i : tasks) {
+    if (owner_[i] < 0)
+      local.push_back(i);
+    else
+      remote[static_cast<std::size_t>(owner_[i])].push_back(i);
+  }
+  Result<void> first;
+  for (std::size_t k = 0; k < processes_.size(); ++k) {
+    if (remote[k].empty()) continue;
+    ModuleProcess& p = *processes_[k];
+    std::lock_guard<std::mutex> lock(p.mutex);
+    ProcessCommand c;
+    c.kind = ProcessCommandKind::kTurnOnTogether;
+    c.count = static_cast<std::uint32_t>(std::min(remote[k].size(), ProcessCommand::kMaxTasks));
+    std::copy_n(remote[k].begin(), c.count, c.tasks.begin());
+    auto r = p.running() ? send(p, c) : make_error(Errc::kState, fmt::format("process {} is not running", p.name()));
+    if (!r && first) first = r;
+  }
+  if (!local.empty())
+    if (auto r = local_->turn_on_together(local); !r && first) first = r;
+  return first;
+}
+
+Result<void> ProcessExecutive::commit_switch(const SwitchCommit& commit) {
+  for (const auto* list : {&commit.leaving, &commit.joining})
+    for (const std::size_t i : *list)
+      if (owner_[i] >= 0)
+        return make_error(Errc::kState, fmt::format("{} runs in process {}: switches of tasks in module processes "
+                                                    "are not supported yet (docs/processes.md)",
+                                                    tasks_[i]->name(), tasks_[i]->spec().process));
+  return local_->commit_switch(commit);
+}
+
+Result<void> ProcessExecutive::reinit(std::size_t task) {
+  ModuleProcess* p = owner(task);
+  if (p == nullptr) return local_->reinit(task);
+  std::lock_guard<std::mutex> lock(p->mutex);
+  if (!p->running()) return make_error(Errc::kState, fmt::format("process {} is not running", p->name()));
+  return send(*p, command_for(ProcessCommandKind::kReinit, task));
+}
+
+void ProcessExecutive::shutdown() {
+  if (stopped_) return;
+  stopped_ = true;
+  stopping_.store(true, std::memory_order_release);  // release: the supervisor ends on it
+  wake_supervisor();
+  if (supervisor_.joinable()) supervisor_.join();
+  local_->shutdown();
+  // Their tasks are off and killed by now (Subsystem::stop); quit ends each worker in order.
+  for (auto& p : processes_) {
+    std::lock_guard<std::mutex> lock(p->mutex);
+    if (const std::string how = p->stop(); !how.empty())
+      spdlog::warn("process {} did not end cleanly ({})", p->name(), how);
+  }
+}
+
+void ProcessExecutive::wake_supervisor() const {
+  const std::uint64_t one = 1;
+  if (wake_fd_ >= 0) (void)!::write(wake_fd_, &one, sizeof one);
+}
+
+void ProcessExecutive::supervise() {
+  std::vector<pollfd> fds;
+  std::vector<ModuleProcess*> watched;
+  while (!stopping_.load(std::memory_order_acquire)) {  // acquire: pairs with shutdown()
+    fds.assign(1, pollfd{wake_fd_, POLLIN, 0});
+    watched.clear();
+    for (auto& p : processes_) {
+      const int fd = p->pidfd();
+      if (p->running() && fd >= 0) {
+        fds.push_back(pollfd{fd, POLLIN, 0});
+        watched.push_back(p.get());
+      }
+    }
+    // Without an eventfd, look again now and then for processes started since.
+    const int timeout_ms = wake_fd_ >= 0 ? -1 : 100;
+    if (::poll(fds.data(), fds.size(), timeout_ms) <= 0) continue;
+    if ((fds[0].revents & POLLIN) != 0) {
+      std::uint64_t count = 0;
+      (void)!::read(wake_fd_, &count, sizeof count);
+    }
+    for (std::size_t j = 0; j < watched.size(); ++j) {
+      if ((fds[j + 1].revents & POLLIN) == 0) continue;
+      ModuleProcess& p = *watched[j];
+      std::lock_guard<std::mutex> lock(p.mutex);
+      // Under the lock, still that process and still ended (a command may have handled it, a
+      // clear started another): a fresh look at its pidfd says.
+      pollfd again{p.pidfd(), POLLIN, 0};
+      if (p.running() && again.fd == fds[j + 1].fd && ::poll(&again, 1, 0) > 0) handle_end(p);
+    }
+  }
+}
+
+}  // namespace chimera

@@ -1,0 +1,73 @@
+#pragma once
+// The executive of a file with module processes (docs/processes.md): the main process's real
+// executive runs the tasks of `main`; each module process runs its tasks with a real executive of
+// its own, started by fork and exec of the chimera binary. This class copies no executive: it
+// routes each request to the process that runs the task (the main process's RealExecutive, or a
+// worker over its command socket), and supervises the workers: a thread polls their pidfds, and
+// when one ends its tasks go to ERROR with the reason and hold the illegal-configuration flag;
+// `clear` starts the process again. Private to the exec part. Nothing here is real-time safe.
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "executive.hpp"
+#include "module_process.hpp"
+#include "real_executive.hpp"
+#include "task_block.hpp"
+
+namespace chimera {
+
+class ProcessExecutive final : public Executive {
+ public:
+  explicit ProcessExecutive(ExecutiveSetup setup);
+  ~ProcessExecutive() override;
+  ProcessExecutive(const ProcessExecutive&) = delete;
+  ProcessExecutive& operator=(const ProcessExecutive&) = delete;
+  ProcessExecutive(ProcessExecutive&&) = delete;
+  ProcessExecutive& operator=(ProcessExecutive&&) = delete;
+
+  [[nodiscard]] ClockKind clock() const noexcept override { return ClockKind::kReal; }
+  [[nodiscard]] std::int64_t now_ns() const override { return local_->now_ns(); }
+  [[nodiscard]] int cpu_of(std::size_t task) const override { return local_->cpu_of(task); }
+  Result<void> signal(std::size_t task, Signal signal) override;
+  Result<void> turn_on_together(const std::vector<std::size_t>& tasks) override;
+  Result<void> commit_switch(const SwitchCommit& commit) override;
+  Result<void> reinit(std::size_t task) override;
+  void run_for(std::int64_t ns) override { local_->run_for(ns); }
+  void serve(ServiceHooks hooks) override { local_->serve(std::move(hooks)); }
+  void stop_serving() override { local_->stop_serving(); }
+  void variable_written(VarIndex v) override { local_->variable_written(v); }
+  void shutdown() override;
+
+ private:
+  /// The module process that runs task `task`, or nullptr for the main process.
+  [[nodiscard]] ModuleProcess* owner(std::size_t task) const;
+  /// Sends one command to process `p` (its mutex held), handling its end if it ends meanwhile.
+  Result<void> send(ModuleProcess& p, const ProcessCommand& command);
+  /// Process `p` has ended (its mutex held): reaped, its tasks to ERROR with the reason.
+  void handle_end(ModuleProcess& p);
+  /// `clear` of a task of ended process `p` (its mutex held): the process again, its tasks spawned.
+  Result<void> restart(ModuleProcess& p, std::size_t task);
+  Result<void> start(ModuleProcess& p);
+  /// The supervisor thread's body: poll every running process's pidfd.
+  void supervise();
+  void wake_supervisor() const;
+
+  std::vector<Task*> tasks_;
+  EventLog* events_;
+  TaskBlock* block_;
+  WorkerLaunch launch_;
+  std::unique_ptr<RealExecutive> local_;  // the tasks of main
+  std::vector<std::unique_ptr<ModuleProcess>> processes_;
+  std::vector<int> owner_;  // per task: its index in processes_, -1 for main
+  int wake_fd_ = -1;        // eventfd: the set of processes changed, or stop
+  std::atomic<bool> stopping_{false};
+  std::thread supervisor_;
+  bool stopped_ = false;  // the control thread's
+};
+
+}  // namespace chimera
