@@ -99,9 +99,9 @@ Result<void> Subsystem::Impl::build_runtime(const std::string& configuration, st
   // Module processes run on the real clock only: the virtual clock simulates every task on one thread.
   std::vector<TaskShared*> shared;
   if (m.options.clock == ClockKind::kReal && m.spec.uses_module_processes()) {
-    auto block = TaskBlock::create(resolved.tasks.size());
-    if (!block) return block.error();
-    m.block = std::make_unique<TaskBlock>(std::move(*block));
+    auto made = TaskBlock::create(resolved.tasks.size());
+    if (!made) return made.error();
+    m.block = std::make_unique<TaskBlock>(std::move(*made));
     for (std::size_t i = 0; i < resolved.tasks.size(); ++i)
       shared.push_back(m.spec.tasks[i].process == kMainProcess ? nullptr : m.block->slot(i));
   }
@@ -130,29 +130,6 @@ Result<void> Subsystem::Impl::build_runtime(const std::string& configuration, st
                                                         *m.executive, *m.table, *m.events);
   return {};
 }
-
-namespace {
-
-// How the main process starts its module processes: the chimera binary in its worker mode, told
-// the file, the table and the options of this run.
-ProcessSetup process_setup(const SubsystemSpec& spec, const RunOptions& options, TaskBlock* block,
-                           const std::string& start) {
-  ProcessSetup p;
-  p.block = block;
-  p.worker_program = options.worker_program;
-  if (p.worker_program.empty()) {
-    std::array<char, 4096> self{};
-    const ssize_t n = ::readlink("/proc/self/exe", self.data(), self.size() - 1);
-    p.worker_program = n > 0 ? std::string(self.data(), static_cast<std::size_t>(n)) : "chimera";
-  }
-  p.worker_args = {"--file", spec.file, "--table", spec.name + options.shm_suffix, "--config", start};
-  if (!options.realtime_priorities) p.worker_args.emplace_back("--no-realtime");
-  if (options.measure_cpu_time) p.worker_args.emplace_back("--cpu-time");
-  if (options.rt_check) p.worker_args.emplace_back("--rt-check");
-  return p;
-}
-
-}  // namespace
 
 Subsystem::Subsystem() : impl_(std::make_unique<Impl>()) {}
 Subsystem::~Subsystem() { stop(); }

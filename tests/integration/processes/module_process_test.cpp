@@ -115,8 +115,11 @@ TEST_F(ModuleProcessTest, CrashesStopOnlyTheirTasksAndClearBringsThemBack) {
     return true;
   };
   ASSERT_TRUE(run_until(s, grew));
-  for (const auto& t : s.snapshot())
-    if (t.name == "traj" || t.name == "pid" || t.name == "robot") EXPECT_EQ(t.state, TaskState::kOn) << t.name;
+  for (const auto& t : s.snapshot()) {
+    if (t.name == "traj" || t.name == "pid" || t.name == "robot") {
+      EXPECT_EQ(t.state, TaskState::kOn) << t.name;
+    }
+  }
 
   // clear starts each process again: its task is OFF, then on as usual, and cycles in the new process.
   for (const char* name : {"segv", "aborts"}) {
