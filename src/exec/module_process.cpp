@@ -45,6 +45,24 @@ ModuleProcess::ModuleProcess(std::string name, std::vector<std::size_t> tasks)
 ModuleProcess::~ModuleProcess() {
   if (running()) (void)stop();
   close_fds();
+  if (unwatched_fd_ >= 0) ::close(unwatched_fd_);
+}
+
+int ModuleProcess::take_watch(std::uint64_t& generation) {
+  std::lock_guard<std::mutex> lock(watch_mutex_);
+  generation = unwatched_generation_;
+  return std::exchange(unwatched_fd_, -1);
+}
+
+void ModuleProcess::note_kill(std::uint64_t generation, std::string reason) {
+  std::lock_guard<std::mutex> lock(watch_mutex_);
+  killed_generation_ = generation;
+  kill_reason_ = std::move(reason);
+}
+
+std::string ModuleProcess::kill_reason() const {
+  std::lock_guard<std::mutex> lock(watch_mutex_);
+  return killed_generation_ == generation() ? kill_reason_ : std::string();
 }
 
 void ModuleProcess::close_fds() noexcept {
@@ -96,6 +114,14 @@ Result<void> ModuleProcess::start(const WorkerLaunch& launch) {
     return e;
   }
   death_seen_ = false;
+  const std::uint64_t generation = generation_.fetch_add(1, std::memory_order_acq_rel) + 1;  // acq_rel: one order of starts
+  {
+    // The supervisor's own descriptor of this start: it can never name a later process.
+    std::lock_guard<std::mutex> lock(watch_mutex_);
+    if (unwatched_fd_ >= 0) ::close(unwatched_fd_);  // a start that ended before the supervisor took it
+    unwatched_fd_ = ::fcntl(pidfd(), F_DUPFD_CLOEXEC, 0);
+    unwatched_generation_ = generation;
+  }
   state_.store(State::kRunning, std::memory_order_release);  // release: the fds are set for the supervisor
   ProcessReply ready;
   if (auto r = await_reply(ready, kReadyTimeoutMs); !r) {

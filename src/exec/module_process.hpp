@@ -7,6 +7,7 @@
 
 #include <atomic>
 #include <cstddef>
+#include <cstdint>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -54,6 +55,18 @@ class ModuleProcess {
   /// Returns how it ended when that was not a clean exit ("" when it was).
   std::string stop();
 
+  /// The supervisor's own pidfd of the process started last (a duplicate, which names that
+  /// process and no other for as long as it is open), and that start's number; -1 when taken
+  /// already. The caller owns the descriptor. Any thread.
+  int take_watch(std::uint64_t& generation);
+  /// Which start of the process it is (1 for the first); changes only under `mutex`.
+  [[nodiscard]] std::uint64_t generation() const noexcept { return generation_.load(std::memory_order_acquire); }
+  /// The supervisor is about to kill start `generation` of the process, for `reason`: the end
+  /// that follows is told with it. Any thread.
+  void note_kill(std::uint64_t generation, std::string reason);
+  /// Why the supervisor killed the start running now, "" if it did not; under `mutex`.
+  [[nodiscard]] std::string kill_reason() const;
+
   /// Held by whoever sends a command or handles the process's end: one at a time.
   std::mutex mutex;
   /// How it last ended unasked ("killed by SIGSEGV"), "" while it runs or was never started;
@@ -72,6 +85,13 @@ class ModuleProcess {
   int socket_ = -1;
   bool death_seen_ = false;
   std::atomic<State> state_{State::kNotStarted};  // read by the supervisor without the mutex
+  std::atomic<std::uint64_t> generation_{0};      // read by the supervisor without the mutex
+  // What passes between the starter and the supervisor without `mutex` (held only to copy).
+  mutable std::mutex watch_mutex_;
+  int unwatched_fd_ = -1;
+  std::uint64_t unwatched_generation_ = 0;
+  std::uint64_t killed_generation_ = 0;
+  std::string kill_reason_;
 };
 
 }  // namespace chimera

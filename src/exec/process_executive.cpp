@@ -1,6 +1,8 @@
 #include "process_executive.hpp"
 
 #include <poll.h>
+#include <signal.h>
+#include <sys/syscall.h>
 #include <sys/eventfd.h>
 #include <unistd.h>
 
@@ -109,7 +111,9 @@ Result<void> ProcessExecutive::send(ModuleProcess& p, const ProcessCommand& comm
 
 void ProcessExecutive::handle_end(ModuleProcess& p) {
   if (!p.running()) return;
+  const std::string killed_for = p.kill_reason();
   p.ended = p.reap();
+  if (!killed_for.empty()) p.ended = fmt::format("killed by the supervisor: {}", killed_for);
   const std::string reason = fmt::format("its process {} died ({})", p.name(), p.ended);
   const std::int64_t now = now_ns();
   for (const std::size_t i : p.tasks()) tasks_[i]->lose_process(reason.c_str(), now);
@@ -195,33 +199,65 @@ void ProcessExecutive::wake_supervisor() const {
 }
 
 void ProcessExecutive::supervise() {
+  std::vector<Watch> watches;  // this thread's: one per start of a process, until its end is handled
   std::vector<pollfd> fds;
-  std::vector<ModuleProcess*> watched;
   while (!stopping_.load(std::memory_order_acquire)) {  // acquire: pairs with shutdown()
-    fds.assign(1, pollfd{wake_fd_, POLLIN, 0});
-    watched.clear();
     for (auto& p : processes_) {
-      const int fd = p->pidfd();
-      if (p->running() && fd >= 0) {
-        fds.push_back(pollfd{fd, POLLIN, 0});
-        watched.push_back(p.get());
-      }
+      Watch w{p.get(), 0, -1, false};
+      w.pidfd = p->take_watch(w.generation);
+      if (w.pidfd >= 0) watches.push_back(w);
     }
-    // Without an eventfd, look again now and then for processes started since.
-    const int timeout_ms = wake_fd_ >= 0 ? -1 : 100;
-    if (::poll(fds.data(), fds.size(), timeout_ms) <= 0) continue;
-    if ((fds[0].revents & POLLIN) != 0) {
+    fds.assign(1, pollfd{wake_fd_, POLLIN, 0});
+    for (const Watch& w : watches) fds.push_back(pollfd{w.pidfd, POLLIN, 0});
+    // The heartbeat needs a tick while any process runs; without an eventfd, look again now and
+    // then for processes started since.
+    const int timeout_ms = !watches.empty() || wake_fd_ < 0 ? kHeartbeatTickMs : -1;
+    const int ready = ::poll(fds.data(), fds.size(), timeout_ms);
+    if (ready > 0 && (fds[0].revents & POLLIN) != 0) {
       std::uint64_t count = 0;
       (void)!::read(wake_fd_, &count, sizeof count);
     }
-    for (std::size_t j = 0; j < watched.size(); ++j) {
-      if ((fds[j + 1].revents & POLLIN) == 0) continue;
-      ModuleProcess& p = *watched[j];
-      std::lock_guard<std::mutex> lock(p.mutex);
-      // Under the lock, still that process and still ended (a command may have handled it, a
-      // clear started another): a fresh look at its pidfd says.
-      pollfd again{p.pidfd(), POLLIN, 0};
-      if (p.running() && again.fd == fds[j + 1].fd && ::poll(&again, 1, 0) > 0) handle_end(p);
+    for (std::size_t j = watches.size(); j-- > 0;) {
+      if (ready <= 0 || (fds[j + 1].revents & POLLIN) == 0) continue;
+      Watch& w = watches[j];
+      {
+        std::lock_guard<std::mutex> lock(w.process->mutex);
+        // Still the start this descriptor names, and not handled yet (a command may have).
+        if (w.process->running() && w.process->generation() == w.generation) handle_end(*w.process);
+      }
+      ::close(w.pidfd);
+      watches.erase(watches.begin() + static_cast<std::ptrdiff_t>(j));
+    }
+    check_heartbeats(watches);
+  }
+  for (const Watch& w : watches) ::close(w.pidfd);
+}
+
+std::int64_t ProcessExecutive::stuck_bound_ns(const Task& task, BusyIn method) {
+  if (method != BusyIn::kCycle) return kStuckMethodNs;
+  const std::int64_t span = std::max(task.period_ns(), task.spec().deadline_ns);
+  return std::max(kStuckPeriods * span, kStuckCycleFloorNs);
+}
+
+void ProcessExecutive::check_heartbeats(std::vector<Watch>& watches) {
+  const std::int64_t now = now_ns();
+  for (Watch& w : watches) {
+    if (w.killed) continue;
+    for (const std::size_t i : w.process->tasks()) {
+      const TaskShared& slot = *block_->slot(i);
+      const std::int64_t since = slot.busy_since_ns.load(std::memory_order_acquire);  // acquire: pairs with BusyScope
+      if (since == TaskShared::kIdle) continue;
+      const BusyIn method = slot.busy_in.load(std::memory_order_relaxed);  // ordered by the acquire above
+      const std::int64_t busy = now - since;
+      if (busy <= stuck_bound_ns(*tasks_[i], method)) continue;
+      const std::string reason = fmt::format("{} stuck in {}() for {:.0f} ms", tasks_[i]->name(),
+                                             busy_in_name(method), static_cast<double>(busy) / 1e6);
+      w.process->note_kill(w.generation, reason);
+      // By the supervisor's own pidfd: only ever this start of the process.
+      ::syscall(SYS_pidfd_send_signal, w.pidfd, SIGKILL, nullptr, 0);
+      w.killed = true;
+      if (events_ != nullptr) events_->add(Event{now, "", fmt::format("process {}: {}; killed", w.process->name(), reason)});
+      break;
     }
   }
 }

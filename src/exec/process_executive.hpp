@@ -53,8 +53,24 @@ class ProcessExecutive final : public Executive {
   /// `clear` of a task of ended process `p` (its mutex held): the process again, its tasks spawned.
   Result<void> restart(ModuleProcess& p, std::size_t task);
   Result<void> start(ModuleProcess& p);
-  /// The supervisor thread's body: poll every running process's pidfd.
+  /// One start of a module process as the supervisor watches it, through a pidfd of its own.
+  struct Watch {
+    ModuleProcess* process;
+    std::uint64_t generation;
+    int pidfd;
+    bool killed;  // for a stuck task: its end is on the way
+  };
+  /// The heartbeat: a task of a module process inside one method longer than this is stuck.
+  static constexpr int kHeartbeatTickMs = 10;
+  static constexpr std::int64_t kStuckPeriods = 10;                   // cycle(): ten periods (or deadlines),
+  static constexpr std::int64_t kStuckCycleFloorNs = 200'000'000;     // and at least 200 ms
+  static constexpr std::int64_t kStuckMethodNs = 10'000'000'000;      // init, on, off...: 10 s
+  [[nodiscard]] static std::int64_t stuck_bound_ns(const Task& task, BusyIn method);
+  /// The supervisor thread's body: poll every running process's pidfd, and every tick look at
+  /// their tasks' heartbeats.
   void supervise();
+  /// Kills each process with a task stuck in a method (docs/processes.md). Supervisor thread.
+  void check_heartbeats(std::vector<Watch>& watches);
   void wake_supervisor() const;
 
   std::vector<Task*> tasks_;

@@ -23,6 +23,11 @@ const char* hook_name(std::uint8_t hook) {
 }
 }  // namespace
 
+const char* busy_in_name(BusyIn method) noexcept {
+  static constexpr std::array<const char*, 7> kNames = {"init", "on", "cycle", "off", "kill", "clear", "reinit"};
+  return kNames[static_cast<std::size_t>(method)];
+}
+
 Task::Task(const ResolvedTask& resolved, GlobalTable& table, const SubsystemFlags& flags, TaskShared* shared)
     : spec_(*resolved.spec),
       resolved_(resolved),
@@ -121,6 +126,7 @@ std::int64_t Task::begin_job(std::int64_t release_ns, std::int64_t start_ns) noe
   timing_.release_ns = release_ns;
   timing_.start_ns = start_ns;
   job_ = Job{true, false, release_ns, start_ns, exec_clock_now()};
+  const BusyScope busy(*shared_, BusyIn::kCycle, start_ns);
   module_->virtual_ns_ = 0;
   local_->pull_in_vars();
   // An aperiodic task first takes its event from the resource port, then processes it.
@@ -173,6 +179,7 @@ bool Task::reinit(std::int64_t now_ns) noexcept {
   if (state() != TaskState::kOn) return false;
   local_->pull_in_consts();
   reinits_.fetch_add(1, std::memory_order_relaxed);  // a counter read on its own
+  const BusyScope busy(*shared_, BusyIn::kReinit, now_ns);
   const Status s = call(Hook::kReinit);
   if (!s.is_ok() && !recover(Hook::kReinit, s, now_ns)) return false;
   return state() == TaskState::kOn;
@@ -225,6 +232,8 @@ Result<void> Task::apply(Signal signal, std::int64_t now_ns) {
   if (!transition(from, signal))
     return make_error(Errc::kState, fmt::format("{}: cannot {} a task that is {}", spec_.name, signal_name(signal),
                                                 state_name(from)));
+  static constexpr BusyIn kMethodOf[] = {BusyIn::kInit, BusyIn::kOn, BusyIn::kOff, BusyIn::kKill, BusyIn::kClear};
+  const BusyScope busy(*shared_, kMethodOf[static_cast<std::size_t>(signal)], now_ns);
   switch (signal) {
     case Signal::kSpawn: return spawn(now_ns);
     case Signal::kOn: return turn_on(now_ns);
@@ -353,6 +362,8 @@ Result<void> Task::clear(std::int64_t now_ns) {
 }
 
 void Task::lose_process(const char* reason, std::int64_t now_ns) noexcept {
+  // The dead process may have died inside a method: its heartbeat must not outlive it.
+  shared_->busy_since_ns.store(TaskShared::kIdle, std::memory_order_release);  // release: as in BusyScope
   const TaskState before = state();
   if (before == TaskState::kNotCreated) return;
   if (before != TaskState::kError) set_state(TaskState::kError);

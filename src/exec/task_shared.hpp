@@ -9,6 +9,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <limits>
 
 #include "chimera/exec/stats.hpp"
 #include "chimera/lifecycle/state.hpp"
@@ -16,16 +17,44 @@
 
 namespace chimera {
 
+/// The module method a task's thread is inside (its heartbeat, below).
+enum class BusyIn : std::uint8_t { kInit, kOn, kCycle, kOff, kKill, kClear, kReinit };
+
+/// The method's name as the module's author wrote it ("cycle").
+const char* busy_in_name(BusyIn method) noexcept;
+
 struct TaskShared {
   static constexpr std::size_t kEventCapacity = 64;
+  static constexpr std::int64_t kIdle = std::numeric_limits<std::int64_t>::min();
 
   alignas(64) std::atomic<TaskState> state{TaskState::kNotCreated};
   std::atomic<bool> ever_in_error{false};
+  /// The heartbeat (docs/processes.md): since when (subsystem clock) the task's thread has been
+  /// inside a module method, and which; kIdle between methods. The supervisor kills a module
+  /// process whose task stays too long in one.
+  std::atomic<std::int64_t> busy_since_ns{kIdle};
+  std::atomic<BusyIn> busy_in{BusyIn::kCycle};
   TaskStats stats;
   EventRing<kEventCapacity> events;
 };
 
 static_assert(std::atomic<TaskState>::is_always_lock_free, "a task's state is shared between processes");
 static_assert(std::atomic<std::uint64_t>::is_always_lock_free, "statistics are shared between processes");
+static_assert(std::atomic<std::int64_t>::is_always_lock_free, "the heartbeat is shared between processes");
+
+/// Stamps the heartbeat for the scope of one module method. Real-time safe: three stores.
+class BusyScope {
+ public:
+  BusyScope(TaskShared& shared, BusyIn method, std::int64_t now_ns) noexcept : shared_(shared) {
+    shared_.busy_in.store(method, std::memory_order_relaxed);  // published by the release below
+    shared_.busy_since_ns.store(now_ns, std::memory_order_release);  // release: the method is read with it
+  }
+  ~BusyScope() { shared_.busy_since_ns.store(TaskShared::kIdle, std::memory_order_release); }  // release: ordered after the method
+  BusyScope(const BusyScope&) = delete;
+  BusyScope& operator=(const BusyScope&) = delete;
+
+ private:
+  TaskShared& shared_;
+};
 
 }  // namespace chimera

@@ -1,7 +1,9 @@
 // Module processes (issue 15, docs/processes.md): Figure 4's loop in the main process beside a
-// module that writes through a null pointer and one that calls abort(), each in a process of its
-// own. The loop keeps cycling, the faulty tasks are ERROR with the signal that ended their
-// process, the illegal-configuration flag is up, and clear + on brings them back in a new process.
+// module that writes through a null pointer, one that calls abort(), one that calls exit(3) and
+// one that never returns from cycle(), each in a process of its own. The loop keeps cycling, the
+// faulty tasks are ERROR with what ended their process (the stuck one's killed by the supervisor
+// for its heartbeat), the illegal-configuration flag is up, and clear + on brings them back in a
+// new process.
 
 #include <sys/stat.h>
 #include <unistd.h>
@@ -49,8 +51,24 @@ std::string file_text(const TempDir& dir) {
          "    criticality: soft\n"
          "    process: aborting\n"
          "    rename: {faulty_count: abort_count}\n"
-         "    params: {after: 25, once_file: " + dir.file("abort.once") + "}\n";
+         "    params: {after: 25, once_file: " + dir.file("abort.once") + "}\n"
+         "  - name: exits\n"
+         "    module: exit_in_cycle\n"
+         "    period: 2ms\n"
+         "    criticality: soft\n"
+         "    process: exiting\n"
+         "    rename: {faulty_count: exit_count}\n"
+         "    params: {after: 25, once_file: " + dir.file("exit.once") + "}\n"
+         "  - name: spin\n"
+         "    module: loop_in_cycle\n"
+         "    period: 2ms\n"
+         "    criticality: soft\n"
+         "    process: spinning\n"
+         "    rename: {faulty_count: spin_count}\n"
+         "    params: {after: 25, once_file: " + dir.file("spin.once") + "}\n";
 }
+
+constexpr const char* kFaulty[] = {"segv", "aborts", "exits", "spin"};
 
 const TaskSnapshot& task_of(const std::vector<TaskSnapshot>& all, const std::string& name) {
   const auto it = std::find_if(all.begin(), all.end(), [&](const TaskSnapshot& t) { return t.name == name; });
@@ -93,20 +111,24 @@ class ModuleProcessTest : public ::testing::Test {
 
 TEST_F(ModuleProcessTest, CrashesStopOnlyTheirTasksAndClearBringsThemBack) {
   Subsystem& s = *subsystem_;
-  const auto both_in_error = [](const std::vector<TaskSnapshot>& all) {
-    return task_of(all, "segv").state == TaskState::kError && task_of(all, "aborts").state == TaskState::kError;
+  const auto all_in_error = [](const std::vector<TaskSnapshot>& all) {
+    for (const char* name : kFaulty)
+      if (task_of(all, name).state != TaskState::kError) return false;
+    return true;
   };
-  ASSERT_TRUE(run_until(s, both_in_error));
+  ASSERT_TRUE(run_until(s, all_in_error));
   const auto at_faults = s.snapshot();
-  EXPECT_NE(task_of(at_faults, "segv").last_error.find("its process faulty died (killed by SIGSEGV"),
-            std::string::npos)
-      << task_of(at_faults, "segv").last_error;
-  EXPECT_NE(task_of(at_faults, "aborts").last_error.find("its process aborting died (killed by SIGABRT"),
-            std::string::npos)
-      << task_of(at_faults, "aborts").last_error;
+  const auto says = [&](const char* task, const std::string& reason) {
+    EXPECT_NE(task_of(at_faults, task).last_error.find(reason), std::string::npos)
+        << task << ": " << task_of(at_faults, task).last_error;
+  };
+  says("segv", "its process faulty died (killed by SIGSEGV");
+  says("aborts", "its process aborting died (killed by SIGABRT");
+  says("exits", "its process exiting died (exited with code 3)");
+  says("spin", "its process spinning died (killed by the supervisor: spin stuck in cycle() for ");
   EXPECT_TRUE(s.illegal_configuration());
   // The faulty tasks ran in other processes: their cycles were counted where the main process reads them.
-  EXPECT_GE(task_of(at_faults, "segv").stats.cycles, 24U);
+  for (const char* name : kFaulty) EXPECT_GE(task_of(at_faults, name).stats.cycles, 24U) << name;
 
   // Figure 4's loop keeps cycling, ON, after both deaths.
   const auto grew = [&](const std::vector<TaskSnapshot>& now) {
@@ -122,16 +144,17 @@ TEST_F(ModuleProcessTest, CrashesStopOnlyTheirTasksAndClearBringsThemBack) {
   }
 
   // clear starts each process again: its task is OFF, then on as usual, and cycles in the new process.
-  for (const char* name : {"segv", "aborts"}) {
+  for (const char* name : kFaulty) {
     auto cleared = s.signal(name, Signal::kClear);
     ASSERT_TRUE(cleared.ok()) << cleared.error().message;
     EXPECT_EQ(task_of(s.snapshot(), name).state, TaskState::kOff);
     auto on = s.signal(name, Signal::kOn);
     ASSERT_TRUE(on.ok()) << on.error().message;
   }
+  EXPECT_FALSE(s.illegal_configuration()) << "every hold given back with the last clear";
   const auto before = s.snapshot();
   const auto back = [&](const std::vector<TaskSnapshot>& now) {
-    for (const char* name : {"segv", "aborts"})
+    for (const char* name : kFaulty)
       if (task_of(now, name).state != TaskState::kOn ||
           task_of(now, name).stats.cycles <= task_of(before, name).stats.cycles + 30)
         return false;
