@@ -26,9 +26,32 @@ void reply(int socket_fd, const Result<void>& r) {
   (void)::send(socket_fd, &message, sizeof message, MSG_NOSIGNAL);
 }
 
-Result<void> carry_out(Executive& executive, const ProcessCommand& c, const std::vector<bool>& mine) {
-  const std::size_t count = std::min<std::size_t>(c.count, ProcessCommand::kMaxTasks);
-  std::vector<std::size_t> tasks(c.tasks.begin(), c.tasks.begin() + static_cast<std::ptrdiff_t>(count));
+std::vector<std::size_t> indices(const std::array<std::uint32_t, ProcessCommand::kMaxTasks>& list, std::uint32_t n) {
+  const std::size_t count = std::min<std::size_t>(n, ProcessCommand::kMaxTasks);
+  return {list.begin(), list.begin() + static_cast<std::ptrdiff_t>(count)};
+}
+
+Result<void> commit(Executive& executive, const ProcessCommand& c, const std::vector<bool>& mine,
+                    const ResolvedSubsystem& resolved) {
+  SwitchCommit part;
+  part.leaving = indices(c.tasks, c.count);
+  part.joining = indices(c.joining, c.joining_count);
+  for (const std::size_t i : indices(c.target, c.target_count)) {
+    if (i >= resolved.tasks.size()) return make_error(Errc::kInvalidInput, fmt::format("no task {}", i));
+    part.target.push_back(resolved.tasks[i].spec->name);
+  }
+  for (const auto* list : {&part.leaving, &part.joining})
+    for (const std::size_t i : *list)
+      if (i >= mine.size() || !mine[i]) return make_error(Errc::kInvalidInput, fmt::format("task {} is not mine", i));
+  part.at_ns = c.at_ns;
+  part.part = static_cast<SwitchCommit::Part>(c.part);
+  return executive.commit_switch(part);
+}
+
+Result<void> carry_out(Executive& executive, const ProcessCommand& c, const std::vector<bool>& mine,
+                       const ResolvedSubsystem& resolved) {
+  if (c.kind == ProcessCommandKind::kCommit) return commit(executive, c, mine, resolved);
+  const std::vector<std::size_t> tasks = indices(c.tasks, c.count);
   for (const std::size_t i : tasks)
     if (i >= mine.size() || !mine[i]) return make_error(Errc::kInvalidInput, fmt::format("task {} is not mine", i));
   if (tasks.empty() && c.kind != ProcessCommandKind::kQuit) return make_error(Errc::kInvalidInput, "no task");
@@ -36,7 +59,8 @@ Result<void> carry_out(Executive& executive, const ProcessCommand& c, const std:
     case ProcessCommandKind::kSignal: return executive.signal(tasks.front(), c.signal);
     case ProcessCommandKind::kTurnOnTogether: return executive.turn_on_together(tasks);
     case ProcessCommandKind::kReinit: return executive.reinit(tasks.front());
-    case ProcessCommandKind::kQuit: break;
+    case ProcessCommandKind::kQuit:
+    case ProcessCommandKind::kCommit: break;
   }
   return {};
 }
@@ -101,7 +125,7 @@ int run_module_process(const SubsystemSpec& spec, const Registry& registry, cons
       reply(sock, Result<void>{});
       return 0;
     }
-    reply(sock, carry_out(*executive, c, mine));
+    reply(sock, carry_out(*executive, c, mine, resolved));
   }
 }
 

@@ -71,6 +71,12 @@ struct SwitchCommit {
   /// configuration runs on to the next boundary first (the real clock simply took that long).
   bool slow = false;
   std::vector<std::string> target;  // the target configuration's tasks: the plan from the commit on
+  /// The commit's instant on the executive's clock; -1: the next boundary of the fastest task
+  /// involved that leaves time to post it. Given when several executives commit one switch.
+  std::int64_t at_ns = -1;
+  /// Which half to carry out: a switch across module processes makes every leaving task off, in
+  /// every process, before any joining task turns on (one writer per variable at any time).
+  enum class Part : std::uint8_t { kWhole, kLeave, kJoin } part = Part::kWhole;
 };
 
 /// What the subsystem interface asks the executive to serve while it runs.

@@ -164,6 +164,17 @@ Result<void> ModuleProcess::await_reply(ProcessReply& reply, std::int64_t timeou
 }
 
 Result<void> ModuleProcess::command(const ProcessCommand& command) {
+  if (auto posted = post(command); !posted) return posted;
+  return await_answer();
+}
+
+Result<void> ModuleProcess::await_answer() {
+  ProcessReply reply;
+  if (auto r = await_reply(reply, kReplyTimeoutMs); !r) return r;
+  return reply.result();
+}
+
+Result<void> ModuleProcess::post(const ProcessCommand& command) {
   if (!running()) return make_error(Errc::kState, fmt::format("process {} is not running", name_));
   if (::send(socket_, &command, sizeof command, MSG_NOSIGNAL) != static_cast<ssize_t>(sizeof command)) {
     if (errno == EPIPE || errno == ECONNRESET) {
@@ -173,9 +184,7 @@ Result<void> ModuleProcess::command(const ProcessCommand& command) {
     }
     return sys_error(name_, "send");
   }
-  ProcessReply reply;
-  if (auto r = await_reply(reply, kReplyTimeoutMs); !r) return r;
-  return reply.result();
+  return {};
 }
 
 std::string ModuleProcess::reap() {

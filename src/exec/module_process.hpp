@@ -42,6 +42,10 @@ class ModuleProcess {
   Result<void> start(const WorkerLaunch& launch);
   /// Sends `command` and waits for its reply, or for the process to end (then death_seen()).
   Result<void> command(const ProcessCommand& command);
+  /// command() in two halves, so that several processes carry out one command at once: post()
+  /// sends, await_answer() waits for its reply (or the end). A failed post needs no await.
+  Result<void> post(const ProcessCommand& command);
+  Result<void> await_answer();
   /// Whether the process is running: started, and not seen to end.
   [[nodiscard]] bool running() const noexcept { return state_.load(std::memory_order_acquire) == State::kRunning; }
   /// Whether its end has been seen but not yet reaped.

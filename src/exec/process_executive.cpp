@@ -9,6 +9,8 @@
 #include <algorithm>
 #include <map>
 #include <mutex>
+#include <string_view>
+#include <unordered_map>
 #include <utility>
 
 #include <fmt/format.h>
@@ -161,13 +163,71 @@ Result<void> ProcessExecutive::turn_on_together(const std::vector<std::size_t>& 
 }
 
 Result<void> ProcessExecutive::commit_switch(const SwitchCommit& commit) {
-  for (const auto* list : {&commit.leaving, &commit.joining})
-    for (const std::size_t i : *list)
-      if (owner_[i] >= 0)
-        return make_error(Errc::kState, fmt::format("{} runs in process {}: switches of tasks in module processes "
-                                                    "are not supported yet (docs/processes.md)",
-                                                    tasks_[i]->name(), tasks_[i]->spec().process));
-  return local_->commit_switch(commit);
+  // One instant for every executive, on the one grid they share: each turns its leaving tasks off
+  // after their last release before it, and its joining tasks on for their first release from
+  // it. Every leaving task, in every process, is off before any joining one turns on: one writer
+  // per variable at any time, as within one process (docs/processes.md).
+  const std::int64_t at_ns = local_->next_commit_ns(commit);
+  SwitchCommit local;
+  std::vector<SwitchCommit> remote(processes_.size());
+  for (const std::size_t i : commit.leaving)
+    (owner_[i] < 0 ? local : remote[static_cast<std::size_t>(owner_[i])]).leaving.push_back(i);
+  for (const std::size_t i : commit.joining)
+    (owner_[i] < 0 ? local : remote[static_cast<std::size_t>(owner_[i])]).joining.push_back(i);
+  std::unordered_map<std::string_view, std::uint32_t> index_of;
+  for (std::size_t i = 0; i < tasks_.size(); ++i) index_of.emplace(tasks_[i]->name(), static_cast<std::uint32_t>(i));
+  std::vector<std::uint32_t> target;
+  for (const auto& name : commit.target)
+    if (const auto it = index_of.find(name); it != index_of.end()) target.push_back(it->second);
+
+  // Every process's lock, in one order (the supervisor takes one at a time): nothing else talks
+  // to a worker while the switch is under way.
+  std::vector<std::unique_lock<std::mutex>> locks;
+  for (auto& p : processes_) locks.emplace_back(p->mutex);
+  Result<void> first;
+  const auto keep = [&first](const Result<void>& r) {
+    if (!r && first) first = r;
+  };
+  for (const SwitchCommit::Part part : {SwitchCommit::Part::kLeave, SwitchCommit::Part::kJoin}) {
+    std::vector<bool> posted(processes_.size(), false);
+    for (std::size_t k = 0; k < processes_.size(); ++k) {
+      ModuleProcess& p = *processes_[k];
+      const SwitchCommit& mine = remote[k];
+      const bool involved = !mine.leaving.empty() || !mine.joining.empty();
+      // The join part tells every running process the new plan (its dispatchers' urgencies).
+      if (!p.running()) {
+        if (involved) keep(make_error(Errc::kState, fmt::format("process {} is not running", p.name())));
+        continue;
+      }
+      if (part == SwitchCommit::Part::kLeave && !involved) continue;
+      ProcessCommand c;
+      c.kind = ProcessCommandKind::kCommit;
+      c.count = static_cast<std::uint32_t>(std::min(mine.leaving.size(), ProcessCommand::kMaxTasks));
+      std::copy_n(mine.leaving.begin(), c.count, c.tasks.begin());
+      c.joining_count = static_cast<std::uint32_t>(std::min(mine.joining.size(), ProcessCommand::kMaxTasks));
+      std::copy_n(mine.joining.begin(), c.joining_count, c.joining.begin());
+      c.target_count = static_cast<std::uint32_t>(std::min(target.size(), ProcessCommand::kMaxTasks));
+      std::copy_n(target.begin(), c.target_count, c.target.begin());
+      c.at_ns = at_ns;
+      c.part = static_cast<std::uint8_t>(part);
+      const auto r = p.post(c);
+      keep(r);
+      posted[k] = r.ok();
+      if (p.death_seen()) handle_end(p);
+    }
+    SwitchCommit here = local;
+    here.slow = commit.slow;
+    here.target = commit.target;
+    here.at_ns = at_ns;
+    here.part = part;
+    keep(local_->commit_switch(here));
+    for (std::size_t k = 0; k < processes_.size(); ++k) {
+      if (!posted[k]) continue;
+      keep(processes_[k]->await_answer());
+      if (processes_[k]->death_seen()) handle_end(*processes_[k]);
+    }
+  }
+  return first;
 }
 
 Result<void> ProcessExecutive::reinit(std::size_t task) {

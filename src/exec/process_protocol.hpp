@@ -18,6 +18,7 @@ enum class ProcessCommandKind : std::uint32_t {
   kTurnOnTogether,  // tasks[0..count): on as one (Executive::turn_on_together)
   kReinit,          // tasks[0]: reinit() between two cycles
   kQuit,            // every task off and killed, then exit 0
+  kCommit,          // one part of a switch (SwitchCommit): tasks leave, joining join, target the plan
 };
 
 struct ProcessCommand {
@@ -26,6 +27,13 @@ struct ProcessCommand {
   Signal signal = Signal::kSpawn;
   std::uint32_t count = 0;
   std::array<std::uint32_t, kMaxTasks> tasks{};
+  // kCommit: `tasks` leave; these join; the target configuration's tasks; the instant and part.
+  std::uint32_t joining_count = 0;
+  std::array<std::uint32_t, kMaxTasks> joining{};
+  std::uint32_t target_count = 0;
+  std::array<std::uint32_t, kMaxTasks> target{};
+  std::int64_t at_ns = -1;
+  std::uint8_t part = 0;  // SwitchCommit::Part
 };
 
 /// The answer to a command, and the worker's first message (ready, or why it cannot run).

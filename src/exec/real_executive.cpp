@@ -382,50 +382,60 @@ Result<void> RealExecutive::turn_on_together(const std::vector<std::size_t>& ind
   return post_all(joining, joins);
 }
 
+std::int64_t RealExecutive::next_commit_ns(const SwitchCommit& commit) const {
+  // At the next boundary of the fastest task involved that leaves time to post the commit.
+  const std::int64_t shortest = shortest_period(tasks_, commit);
+  const std::int64_t now = now_ns();
+  return shortest > 0 ? release_policy::next_boundary_after(now + kCommitMarginNs, shortest) : now;
+}
+
 Result<void> RealExecutive::commit_switch(const SwitchCommit& commit) {
   const std::vector<std::size_t>& leaving = commit.leaving;
   const std::vector<std::size_t>& joining = commit.joining;
-  SchedulePlan plan = make_schedule_plan(subsystem_, order_, subsystem_cpus(*subsystem_.spec), commit.target);
+  const bool leave_part = commit.part != SwitchCommit::Part::kJoin;
+  const bool join_part = commit.part != SwitchCommit::Part::kLeave;
   Result<void> r;
   {
     std::lock_guard<std::mutex> lock(control_mutex_);
-    // At the next boundary of the fastest task involved that leaves time to post the commit.
-    const std::int64_t shortest = shortest_period(tasks_, commit);
-    const std::int64_t now = now_ns();
-    const std::int64_t commit_ns =
-        shortest > 0 ? release_policy::next_boundary_after(now + kCommitMarginNs, shortest) : now;
+    const std::int64_t commit_ns = commit.at_ns >= 0 ? commit.at_ns : next_commit_ns(commit);
     // Every leaving task answers once it is off: after its last release before the commit. Only
     // then may a joining task turn on, since on() publishes outputs a leaving task wrote: one
     // writer per variable at any time.
     // Successors of the joining tasks must wait for them from the commit's release on, even if
     // the commit runs late: tell them before anything changes.
-    for (const std::size_t i : joining) {
-      Worker& w = *workers_[i];
-      if (w.task->periodic())
-        w.precedence.joining_k.store(release_policy::first_release_index(commit_ns, w.task->period_ns()),
-                                     std::memory_order_release);  // release: pairs with successors' acquire
+    if (leave_part) {
+      for (const std::size_t i : joining) {
+        Worker& w = *workers_[i];
+        if (w.task->periodic())
+          w.precedence.joining_k.store(release_policy::first_release_index(commit_ns, w.task->period_ns()),
+                                       std::memory_order_release);  // release: pairs with successors' acquire
+      }
     }
     // The commit is timed to a cycle boundary: the control thread runs it at a real-time priority
     // above the tasks', so that it is not the one that comes late.
     const ScopedPriority urgent(realtime_, kCommitPriority);
-    const std::vector<Mail> leave(leaving.size(), Mail{MailKind::kLeaveAt, Signal::kOff, epoch_ns_ + commit_ns});
-    r = post_all(leaving, leave);
-    // Each joining task turns on right before its first release from the commit on, on its own
-    // thread: not earlier, since on() publishes outputs a consumer may still be reading the
-    // leaving producer's last value of. Its first release is the commit's even if the commit ran
-    // late (then it runs late): the leaving task ran none from there, and no release may go
-    // unproduced. They are all posted at once and answer as each turns on.
-    std::vector<Mail> join;
-    for (const std::size_t i : joining) {
-      const Worker& w = *workers_[i];
-      const std::int64_t p = w.task->periodic() ? w.task->period_ns() : 1;
-      join.push_back(Mail{MailKind::kOnAt, Signal::kOn, release_policy::first_release_index(commit_ns, p)});
+    if (leave_part) {
+      const std::vector<Mail> leave(leaving.size(), Mail{MailKind::kLeaveAt, Signal::kOff, epoch_ns_ + commit_ns});
+      r = post_all(leaving, leave);
     }
-    if (auto on = post_all(joining, join); r && !on) r = on;
-    for (const std::size_t i : joining)
-      workers_[i]->precedence.joining_k.store(-1, std::memory_order_release);  // scheduled says it now
+    if (join_part) {
+      // Each joining task turns on right before its first release from the commit on, on its own
+      // thread: not earlier, since on() publishes outputs a consumer may still be reading the
+      // leaving producer's last value of. Its first release is the commit's even if the commit ran
+      // late (then it runs late): the leaving task ran none from there, and no release may go
+      // unproduced. They are all posted at once and answer as each turns on.
+      std::vector<Mail> join;
+      for (const std::size_t i : joining) {
+        const Worker& w = *workers_[i];
+        const std::int64_t p = w.task->periodic() ? w.task->period_ns() : 1;
+        join.push_back(Mail{MailKind::kOnAt, Signal::kOn, release_policy::first_release_index(commit_ns, p)});
+      }
+      if (auto on = post_all(joining, join); r && !on) r = on;
+      for (const std::size_t i : joining)
+        workers_[i]->precedence.joining_k.store(-1, std::memory_order_release);  // scheduled says it now
+    }
   }
-  set_plan(std::move(plan));
+  if (join_part) set_plan(make_schedule_plan(subsystem_, order_, subsystem_cpus(*subsystem_.spec), commit.target));
   return r;
 }
 

@@ -43,6 +43,8 @@ class RealExecutive final : public Executive {
   Result<void> signal(std::size_t index, Signal sig) override;
   Result<void> turn_on_together(const std::vector<std::size_t>& indices) override;
   Result<void> commit_switch(const SwitchCommit& commit) override;
+  /// The instant a switch posted now would commit at (SwitchCommit::at_ns). Not real-time safe.
+  [[nodiscard]] std::int64_t next_commit_ns(const SwitchCommit& commit) const;
   Result<void> reinit(std::size_t index) override;
   void run_for(std::int64_t ns) override;
   void serve(ServiceHooks hooks) override;

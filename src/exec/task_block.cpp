@@ -13,6 +13,8 @@
 
 #include <fmt/format.h>
 
+#include "process_protocol.hpp"
+
 namespace chimera {
 
 namespace {
@@ -41,6 +43,11 @@ Error sys_error(std::string_view what) {
 }  // namespace
 
 Result<TaskBlock> TaskBlock::create(std::size_t tasks) {
+  // A command to a worker names tasks by index in arrays of fixed size (process_protocol.hpp).
+  if (tasks > ProcessCommand::kMaxTasks)
+    return make_error(Errc::kInvalidInput, fmt::format("a subsystem with module processes (process:) has at most {} "
+                                                       "tasks; this one has {}",
+                                                       ProcessCommand::kMaxTasks, tasks));
   TaskBlock b;
   b.fd_ = ::memfd_create("chimera-tasks", MFD_CLOEXEC);
   if (b.fd_ < 0) return sys_error("memfd_create");
