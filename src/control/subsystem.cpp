@@ -99,6 +99,11 @@ Result<void> Subsystem::Impl::build_runtime(const std::string& configuration, st
   // Module processes run on the real clock only: the virtual clock simulates every task on one thread.
   std::vector<TaskShared*> shared;
   if (m.options.clock == ClockKind::kReal && m.spec.uses_module_processes()) {
+    // A worker loads the subsystem from its file (docs/processes.md): text has none to read.
+    if (::access(m.spec.file.c_str(), R_OK) != 0)
+      return make_error(Errc::kInvalidInput, fmt::format("{}: module processes (process:) need the subsystem loaded "
+                                                         "from a file their workers can read",
+                                                         m.spec.file));
     auto made = TaskBlock::create(resolved.tasks.size());
     if (!made) return made.error();
     m.block = std::make_unique<TaskBlock>(std::move(*made));
