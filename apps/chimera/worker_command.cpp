@@ -1,4 +1,4 @@
-// chimera __worker --file FILE --process NAME --table NAME --socket-fd N --block-fd N [--config NAME]
+// chimera __worker --file FILE --process NAME --table NAME --socket-fd N --block-fd N --life N [--config NAME]
 // [--no-realtime] [--cpu-time] [--rt-check]: a module process (docs/processes.md). Not for people:
 // the main process of `chimera run` starts it, and it is left out of the help.
 
@@ -23,6 +23,7 @@ int worker_command(int argc, char** argv) {
   app.add_option("--table", args.table)->required();
   app.add_option("--socket-fd", args.socket_fd)->required();
   app.add_option("--block-fd", args.block_fd)->required();
+  app.add_option("--life", args.life)->required();
   auto* config_opt = app.add_option("--config", config);
   app.add_flag("--no-realtime", no_realtime);
   app.add_flag("--cpu-time", args.measure_cpu_time);

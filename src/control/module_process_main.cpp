@@ -1,8 +1,10 @@
 #include "chimera/control/module_process_main.hpp"
 
+#include <pthread.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdlib>
 #include <memory>
 #include <vector>
@@ -109,6 +111,21 @@ int run_module_process(const SubsystemSpec& spec, const Registry& registry, cons
   setup.hosted = mine;
   setup.epoch_ns = block->epoch_ns();
   std::unique_ptr<Executive> executive = make_executive(std::move(setup));
+  // Held until this process ends, however it ends: the kernel hands it to the main process's
+  // watcher as this thread exits, long before the pidfd says the process is gone.
+  // The thread that holds the life lock runs at the lowest real-time priority: it only waits on
+  // its socket, and when the process is killed it is scheduled to exit (and so to free the
+  // lock) ahead of every ordinary thread of the machine.
+  if (args.realtime_priorities) {
+    sched_param lowest{};
+    lowest.sched_priority = 1;
+    (void)pthread_setschedparam(pthread_self(), SCHED_FIFO, &lowest);
+  }
+  pthread_mutex_t* life = nullptr;
+  if (args.life >= 0 && static_cast<std::size_t>(args.life) < ProcessCommand::kMaxTasks) {
+    life = block->life(static_cast<std::size_t>(args.life));
+    if (pthread_mutex_lock(life) == EOWNERDEAD) pthread_mutex_consistent(life);  // a previous start's
+  }
   reply(sock, Result<void>{});  // ready
 
   for (;;) {
@@ -122,6 +139,9 @@ int run_module_process(const SubsystemSpec& spec, const Registry& registry, cons
     if (got != static_cast<ssize_t>(sizeof c)) continue;
     if (c.kind == ProcessCommandKind::kQuit) {
       executive->shutdown();
+      // Given back by hand: the block is unmapped on the way out, and the kernel can release a
+      // robust lock only where it is still mapped.
+      if (life != nullptr) pthread_mutex_unlock(life);
       reply(sock, Result<void>{});
       return 0;
     }

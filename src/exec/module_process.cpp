@@ -39,8 +39,8 @@ std::string signal_text(int sig) {
 
 }  // namespace
 
-ModuleProcess::ModuleProcess(std::string name, std::vector<std::size_t> tasks)
-    : name_(std::move(name)), tasks_(std::move(tasks)) {}
+ModuleProcess::ModuleProcess(std::string name, std::vector<std::size_t> tasks, std::size_t index)
+    : name_(std::move(name)), tasks_(std::move(tasks)), index_(index) {}
 
 ModuleProcess::~ModuleProcess() {
   if (running()) (void)stop();
@@ -78,7 +78,7 @@ Result<void> ModuleProcess::start(const WorkerLaunch& launch) {
   std::vector<std::string> args{launch.program, "__worker"};
   args.insert(args.end(), launch.args.begin(), launch.args.end());
   args.insert(args.end(), {"--process", name_, "--socket-fd", std::to_string(pair[1]), "--block-fd",
-                           std::to_string(launch.block_fd)});
+                           std::to_string(launch.block_fd), "--life", std::to_string(index_)});
   std::vector<char*> argv;
   argv.reserve(args.size() + 1);
   for (auto& a : args) argv.push_back(a.data());
@@ -197,6 +197,7 @@ std::string ModuleProcess::reap() {
   close_fds();
   pid_ = -1;
   death_seen_ = false;
+  end_marked = false;
   if (rc != 0) return fmt::format("its end could not be read: {}", std::generic_category().message(errno));
   switch (info.si_code) {
     case CLD_EXITED: return fmt::format("exited with code {}", info.si_status);
@@ -204,6 +205,14 @@ std::string ModuleProcess::reap() {
     case CLD_DUMPED: return fmt::format("killed by {} (core dumped)", signal_text(info.si_status));
     default: return fmt::format("ended (wait code {}, status {})", info.si_code, info.si_status);
   }
+}
+
+std::string ModuleProcess::exit_text(int status) {
+  if (WIFEXITED(status)) return fmt::format("exited with code {}", WEXITSTATUS(status));
+  if (WIFSIGNALED(status))
+    return WCOREDUMP(status) ? fmt::format("killed by {} (core dumped)", signal_text(WTERMSIG(status)))
+                             : fmt::format("killed by {}", signal_text(WTERMSIG(status)));
+  return fmt::format("ended (status {})", status);
 }
 
 std::string ModuleProcess::stop() {

@@ -26,7 +26,8 @@ struct WorkerLaunch {
 
 class ModuleProcess {
  public:
-  ModuleProcess(std::string name, std::vector<std::size_t> tasks);
+  /// `index`: its life lock in the task block (TaskBlock::life).
+  ModuleProcess(std::string name, std::vector<std::size_t> tasks, std::size_t index);
   ~ModuleProcess();
   ModuleProcess(const ModuleProcess&) = delete;
   ModuleProcess& operator=(const ModuleProcess&) = delete;
@@ -34,6 +35,9 @@ class ModuleProcess {
   ModuleProcess& operator=(ModuleProcess&&) = delete;
 
   [[nodiscard]] const std::string& name() const noexcept { return name_; }
+  [[nodiscard]] std::size_t index() const noexcept { return index_; }
+  /// The running start's pid (-1 when none); under `mutex`.
+  [[nodiscard]] pid_t pid() const noexcept { return pid_; }
   /// Its tasks' indices in the file, in file order.
   [[nodiscard]] const std::vector<std::size_t>& tasks() const noexcept { return tasks_; }
 
@@ -55,6 +59,8 @@ class ModuleProcess {
   /// Reaps the ended process and says how it ended: "killed by SIGSEGV (core dumped)",
   /// "exited with code 3". Not running afterwards.
   std::string reap();
+  /// How a wait status reads in reap()'s words ("killed by SIGSEGV", "exited with code 3").
+  static std::string exit_text(int status);
   /// Asks it to quit (its tasks off and killed) and waits a bounded time, then kills it; reaps.
   /// Returns how it ended when that was not a clean exit ("" when it was).
   std::string stop();
@@ -76,6 +82,9 @@ class ModuleProcess {
   /// How it last ended unasked ("killed by SIGSEGV"), "" while it runs or was never started;
   /// under `mutex`, the process executive's.
   std::string ended;
+  /// Its death has been seen by its life lock and its tasks are in ERROR, but it is not reaped
+  /// yet (the kernel is still freeing its memory); under `mutex`.
+  bool end_marked = false;
 
  private:
   enum class State : std::uint8_t { kNotStarted, kRunning, kEnded };
@@ -84,6 +93,7 @@ class ModuleProcess {
 
   std::string name_;
   std::vector<std::size_t> tasks_;
+  std::size_t index_;
   pid_t pid_ = -1;
   std::atomic<int> pidfd_{-1};  // read by the supervisor without the mutex (acquire: see start())
   int socket_ = -1;

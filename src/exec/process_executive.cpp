@@ -6,7 +6,13 @@
 #include <sys/eventfd.h>
 #include <unistd.h>
 
+#include <pthread.h>
+
 #include <algorithm>
+#include <cerrno>
+#include <fstream>
+#include <iterator>
+#include <sstream>
 #include <map>
 #include <mutex>
 #include <string_view>
@@ -36,6 +42,7 @@ ProcessCommand command_for(ProcessCommandKind kind, std::size_t task, Signal sig
 ProcessExecutive::ProcessExecutive(ExecutiveSetup setup)
     : tasks_(setup.tasks),
       events_(setup.events),
+      realtime_(setup.realtime_priorities),
       block_(setup.processes.block),
       launch_{setup.processes.worker_program, setup.processes.worker_args, setup.processes.block->fd()} {
   // One ModuleProcess per process name other than main, in order of first appearance.
@@ -57,7 +64,7 @@ ProcessExecutive::ProcessExecutive(ExecutiveSetup setup)
     hosted[i] = false;
   }
   for (std::size_t k = 0; k < names.size(); ++k)
-    processes_.push_back(std::make_unique<ModuleProcess>(names[k], members[k]));
+    processes_.push_back(std::make_unique<ModuleProcess>(names[k], members[k], k));
   setup.hosted = std::move(hosted);
   local_ = std::make_unique<RealExecutive>(std::move(setup));
   // Before any worker starts: they take this epoch, so that every release is on one grid.
@@ -82,6 +89,7 @@ Result<void> ProcessExecutive::signal(std::size_t task, Signal signal) {
   if (p == nullptr) return local_->signal(task, signal);
   if (stopped_) return make_error(Errc::kState, "the subsystem is stopped");
   std::lock_guard<std::mutex> lock(p->mutex);
+  if (p->end_marked) handle_end(*p);  // seen dead by its life lock: reaped now, so clear can start it again
   if (!p->running()) {
     if (!p->ended.empty()) {
       // Its process has ended: clear starts it again; kill destroys the task without one.
@@ -102,24 +110,79 @@ Result<void> ProcessExecutive::signal(std::size_t task, Signal signal) {
 Result<void> ProcessExecutive::start(ModuleProcess& p) {
   auto started = p.start(launch_);
   wake_supervisor();  // a new pidfd to watch
+  if (started) {
+    // Ready means it holds its life lock: the watcher may wait on it now.
+    std::lock_guard<std::mutex> lock(watchers_mutex_);
+    watchers_.emplace_back([this, &p, generation = p.generation(), pid = p.pid()] { watch_life(p, generation, pid); });
+  }
   return started;
 }
 
 Result<void> ProcessExecutive::send(ModuleProcess& p, const ProcessCommand& command) {
+  if (p.end_marked) {
+    handle_end(p);  // dead already: reaped now, and the command refused as to any ended process
+    return make_error(Errc::kSystem, fmt::format("process {} has ended ({})", p.name(), p.ended));
+  }
   auto r = p.command(command);
   if (p.death_seen()) handle_end(p);
   return r;
 }
 
-void ProcessExecutive::handle_end(ModuleProcess& p) {
-  if (!p.running()) return;
+void ProcessExecutive::mark_end(ModuleProcess& p, const std::string& how) {
   const std::string killed_for = p.kill_reason();
-  p.ended = p.reap();
-  if (!killed_for.empty()) p.ended = fmt::format("killed by the supervisor: {}", killed_for);
+  p.ended = killed_for.empty() ? how : fmt::format("killed by the supervisor: {}", killed_for);
   const std::string reason = fmt::format("its process {} died ({})", p.name(), p.ended);
   const std::int64_t now = now_ns();
   for (const std::size_t i : p.tasks()) tasks_[i]->lose_process(reason.c_str(), now);
   if (events_ != nullptr) events_->add(Event{now, "", fmt::format("process {} died ({})", p.name(), p.ended)});
+  p.end_marked = true;
+}
+
+void ProcessExecutive::handle_end(ModuleProcess& p) {
+  if (!p.running()) return;
+  const bool marked = p.end_marked;
+  const std::string ended = p.ended;
+  const std::string how = p.reap();  // waits while the kernel frees the process's memory
+  if (!marked) {
+    mark_end(p, how);
+  } else {
+    // Its tasks went to ERROR when its life lock came free; the wait status is the last word.
+    p.ended = ended;
+  }
+  p.end_marked = false;
+}
+
+void ProcessExecutive::watch_life(ModuleProcess& p, std::uint64_t generation, pid_t pid) {
+  if (realtime_) {
+    // As the worker's lock holder: woken by a death, it runs ahead of every ordinary thread.
+    sched_param lowest{};
+    lowest.sched_priority = 1;
+    (void)pthread_setschedparam(pthread_self(), SCHED_FIFO, &lowest);
+  }
+  pthread_mutex_t* life = block_->life(p.index());
+  // Blocks until the worker's thread that holds it exits: its death, or its quit.
+  const int locked = pthread_mutex_lock(life);
+  // What the process ended with, while it is still being torn down (its exit_code in /proc, the
+  // wait status as waitid will give it); "" when it cannot be read.
+  std::string how;
+  {
+    std::ifstream stat(fmt::format("/proc/{}/stat", pid));
+    std::string text((std::istreambuf_iterator<char>(stat)), std::istreambuf_iterator<char>());
+    const auto paren = text.rfind(')');
+    if (paren != std::string::npos) {
+      std::istringstream fields(text.substr(paren + 1));
+      std::string field;
+      // Fields from the 3rd (state) on: exit_code is the 52nd.
+      for (int n = 3; n <= 52 && fields >> field; ++n)
+        if (n == 52) how = ModuleProcess::exit_text(std::stoi(field));
+    }
+  }
+  if (locked == EOWNERDEAD) pthread_mutex_consistent(life);
+  if (locked == 0 || locked == EOWNERDEAD) pthread_mutex_unlock(life);  // for the next start
+  std::lock_guard<std::mutex> lock(p.mutex);
+  // Still that start, and an end nobody asked for (a quit reaps it first; a command may have).
+  if (p.running() && p.generation() == generation && !p.end_marked && !stopping_.load(std::memory_order_acquire))
+    mark_end(p, how.empty() ? std::string("its end not read yet") : how);  // acquire: pairs with shutdown()
 }
 
 Result<void> ProcessExecutive::restart(ModuleProcess& p, std::size_t task) {
@@ -251,6 +314,10 @@ void ProcessExecutive::shutdown() {
     if (const std::string how = p->stop(); !how.empty())
       spdlog::warn("process {} did not end cleanly ({})", p->name(), how);
   }
+  // Every worker has ended, so every watcher's wait is over.
+  std::lock_guard<std::mutex> lock(watchers_mutex_);
+  for (auto& w : watchers_)
+    if (w.joinable()) w.join();
 }
 
 void ProcessExecutive::wake_supervisor() const {

@@ -7,9 +7,12 @@
 // when one ends its tasks go to ERROR with the reason and hold the illegal-configuration flag;
 // `clear` starts the process again. Private to the exec part. Nothing here is real-time safe.
 
+#include <sys/types.h>
+
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
@@ -48,8 +51,14 @@ class ProcessExecutive final : public Executive {
   [[nodiscard]] ModuleProcess* owner(std::size_t task) const;
   /// Sends one command to process `p` (its mutex held), handling its end if it ends meanwhile.
   Result<void> send(ModuleProcess& p, const ProcessCommand& command);
-  /// Process `p` has ended (its mutex held): reaped, its tasks to ERROR with the reason.
+  /// Process `p` has ended (its mutex held): reaped, and its tasks to ERROR with the reason
+  /// unless its life lock's watcher put them there already.
   void handle_end(ModuleProcess& p);
+  /// Its tasks to ERROR with `how` it ended, the flag held, an event (its mutex held).
+  void mark_end(ModuleProcess& p, const std::string& how);
+  /// A watcher thread's body, one per start of a process: waits on its life lock, which the
+  /// kernel frees as the process dies, and marks the end at once (docs/processes.md).
+  void watch_life(ModuleProcess& p, std::uint64_t generation, pid_t pid);
   /// `clear` of a task of ended process `p` (its mutex held): the process again, its tasks spawned.
   Result<void> restart(ModuleProcess& p, std::size_t task);
   Result<void> start(ModuleProcess& p);
@@ -75,6 +84,7 @@ class ProcessExecutive final : public Executive {
 
   std::vector<Task*> tasks_;
   EventLog* events_;
+  bool realtime_;  // SCHED_FIFO wanted: the life watchers take the lowest real-time priority
   TaskBlock* block_;
   WorkerLaunch launch_;
   std::unique_ptr<RealExecutive> local_;  // the tasks of main
@@ -83,6 +93,8 @@ class ProcessExecutive final : public Executive {
   int wake_fd_ = -1;        // eventfd: the set of processes changed, or stop
   std::atomic<bool> stopping_{false};
   std::thread supervisor_;
+  std::mutex watchers_mutex_;
+  std::vector<std::thread> watchers_;  // one per start of a module process, joined at shutdown
   bool stopped_ = false;  // the control thread's
 };
 

@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <array>
 #include <atomic>
 #include <cerrno>
 #include <new>
@@ -28,6 +29,9 @@ struct alignas(64) Header {
   std::uint64_t layout = kLayout;
   std::uint64_t tasks = 0;
   std::atomic<std::int64_t> epoch_ns{0};
+  // A robust mutex's list links point into its owner's memory: only the owner and the kernel
+  // read them, never another process, so the rule that shared memory holds no pointer stands.
+  std::array<pthread_mutex_t, ProcessCommand::kMaxTasks> life;
 };
 static_assert(std::atomic<std::int64_t>::is_always_lock_free);
 
@@ -63,6 +67,12 @@ Result<TaskBlock> TaskBlock::create(std::size_t tasks) {
   b.base_ = static_cast<std::byte*>(p);
   auto* header = new (b.base_) Header{};
   header->tasks = tasks;
+  pthread_mutexattr_t attr;
+  pthread_mutexattr_init(&attr);
+  pthread_mutexattr_setpshared(&attr, PTHREAD_PROCESS_SHARED);
+  pthread_mutexattr_setrobust(&attr, PTHREAD_MUTEX_ROBUST);
+  for (auto& m : header->life) pthread_mutex_init(&m, &attr);
+  pthread_mutexattr_destroy(&attr);
   for (std::size_t i = 0; i < tasks; ++i) new (b.base_ + kSlotsOffset + i * sizeof(TaskShared)) TaskShared{};
   return b;
 }
@@ -114,6 +124,10 @@ void TaskBlock::release() noexcept {
 
 TaskShared* TaskBlock::slot(std::size_t task) const noexcept {
   return std::launder(reinterpret_cast<TaskShared*>(base_ + kSlotsOffset + task * sizeof(TaskShared)));
+}
+
+pthread_mutex_t* TaskBlock::life(std::size_t process) const noexcept {
+  return &std::launder(reinterpret_cast<Header*>(base_))->life[process];
 }
 
 std::int64_t TaskBlock::epoch_ns() const noexcept {

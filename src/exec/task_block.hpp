@@ -7,6 +7,8 @@
 // ends leaves nothing of it behind. Exported to the parts above. Not real-time safe (the slots
 // themselves are).
 
+#include <pthread.h>
+
 #include <cstddef>
 #include <cstdint>
 
@@ -36,6 +38,11 @@ class TaskBlock {
   /// CLOCK_MONOTONIC at the executive's time 0, as the main process set it (0: not yet).
   [[nodiscard]] std::int64_t epoch_ns() const noexcept;
   void set_epoch_ns(std::int64_t epoch_ns) noexcept;
+  /// Module process `process`'s life lock (docs/processes.md, "Seeing a death at once"): a
+  /// robust, process-shared mutex its worker holds for as long as it lives. The kernel releases
+  /// it as the worker's threads exit, before it frees the worker's memory, so a waiter in the
+  /// main process learns of the death long before the pidfd does. One per possible process.
+  [[nodiscard]] pthread_mutex_t* life(std::size_t process) const noexcept;
 
  private:
   TaskBlock() = default;

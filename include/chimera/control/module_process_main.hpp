@@ -17,6 +17,7 @@ struct ModuleProcessArgs {
   std::string table;    // the global table's subsystem name (with the run's suffix)
   int socket_fd = -1;   // the command socket
   int block_fd = -1;    // the task block's memfd
+  int life = -1;        // its life lock in the task block (held while it lives); -1: none
   std::optional<std::string> configuration;  // the start configuration (the first plan)
   bool realtime_priorities = true;
   bool measure_cpu_time = false;
