@@ -230,6 +230,10 @@ void RealExecutive::shutdown() {
   }
   for (auto& t : threads_)
     if (t->running) pthread_join(t->handle, nullptr);  // its last member's kill ended it
+  // The dispatchers read the workers' published jobs: they stop here, with no task thread left
+  // to ring them, before the workers can be destroyed (TSAN saw a dispatcher read a freed worker).
+  for (auto& w : workers_) w->dispatcher = nullptr;
+  dispatchers_.clear();
   stopped_at_ns_ = monotonic_ns() - epoch_ns_;
   // A hard job still overdue when the run stopped no longer holds the flag.
   for (std::size_t i = 0; i < overdue_hold_.size(); ++i)

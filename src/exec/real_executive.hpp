@@ -93,7 +93,7 @@ class RealExecutive final : public Executive {
   analysis::ReleaseOrder order_;
   SchedulePlan plan_;
   const std::vector<int> cpus_;  // plan_.cpu as it was made: a switch never moves a task, so any thread may read it
-  std::vector<std::unique_ptr<PriorityDispatcher>> dispatchers_;  // outlive the workers that poke them
+  std::vector<std::unique_ptr<PriorityDispatcher>> dispatchers_;  // stopped by shutdown(), before the workers go
   std::vector<std::unique_ptr<Worker>> workers_;
   std::vector<std::unique_ptr<TaskThread>> threads_;
   std::int64_t epoch_ns_ = 0;

@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -89,6 +90,14 @@ bool run_until(Subsystem& s, Done done) {
 class ModuleProcessTest : public ::testing::Test {
  protected:
   void SetUp() override {
+    // A sanitizer's own SIGSEGV handler would report and exit with its code: in a sanitized
+    // build the workers still die of the signal, as in a plain one. Read by the workers only
+    // (this process read its options at start).
+    for (const char* var : {"ASAN_OPTIONS", "TSAN_OPTIONS"}) {
+      const char* now = std::getenv(var);  // NOLINT(concurrency-mt-unsafe): before any worker or thread
+      const std::string value = (now != nullptr && *now != '\0' ? std::string(now) + ":" : std::string()) + "handle_segv=0";
+      ::setenv(var, value.c_str(), 1);  // NOLINT(concurrency-mt-unsafe): as above
+    }
     const std::string path = dir_.file("fig4_processes.yaml");
     test::write_text(path, file_text(dir_));
     auto plugins = load_file_plugins(path);
