@@ -57,6 +57,13 @@ KEYS = [
         "five-task chain at 1 ms, 40 ms stall of both CPUs: periods after it until every task is on time (worst)"),
     Key("stall_tasks_in_error", "", "the same: tasks in ERROR after the stall (all runs and placements)"),
     Key("virtual_clock_speedup_fig4", "x", "simulated seconds per wall second, Figure 4 on the virtual clock"),
+    Key("process_fig4_latency_p50_ratio", "x",
+        "Figure 4 at 1 kHz, worst task's release latency p50: PID in its own process / all in one"),
+    Key("process_fig4_latency_p99_ratio", "x", "the same, p99"),
+    Key("process_death_to_error_ns_p50", "ns", "a module process killed: to its task in ERROR and the flag up, p50"),
+    Key("process_death_to_error_ns_max", "ns", "the same, worst"),
+    Key("process_clear_to_on_ns_p50", "ns", "clear (the process started anew) then on: to the task ON, p50"),
+    Key("process_clear_to_on_ns_max", "ns", "the same, worst"),
 ]
 
 KEY_NAMES = [k.name for k in KEYS]
@@ -149,6 +156,18 @@ GOALS = [
          if _have(r, "stall_recovery_periods_max", "stall_tasks_in_error") else None,
          lambda r: (f"worst {r['stall_recovery_periods_max']:g} periods; "
                     f"{r['stall_tasks_in_error']:g} tasks in ERROR")),
+    Goal("Figure 4 with the PID in its own process: release latency p50 and p99 within 1.1x of all in one",
+         ["process_fig4_latency_p50_ratio", "process_fig4_latency_p99_ratio"],
+         lambda r: (r["process_fig4_latency_p50_ratio"] <= 1.1 and r["process_fig4_latency_p99_ratio"] <= 1.1)
+         if _have(r, "process_fig4_latency_p50_ratio", "process_fig4_latency_p99_ratio") else None,
+         lambda r: (f"p50 {r['process_fig4_latency_p50_ratio']:.2f}x, p99 {r['process_fig4_latency_p99_ratio']:.2f}x")),
+    Goal("a module process's death seen as ERROR within one period of the fastest task (1 ms)",
+         ["process_death_to_error_ns_max"],
+         lambda r: r["process_death_to_error_ns_max"] <= 1_000_000 if _have(r, "process_death_to_error_ns_max")
+         else None,
+         lambda r: (f"p50 {_fmt(r['process_death_to_error_ns_p50'])}, worst {_fmt(r['process_death_to_error_ns_max'])}"
+                    + (f"; clear to ON p50 {_fmt(r['process_clear_to_on_ns_p50'])}"
+                       if _have(r, "process_clear_to_on_ns_p50") else ""))),
     Goal("virtual-clock runs of Figure 4 at >= 100x real time",
          ["virtual_clock_speedup_fig4"],
          lambda r: r["virtual_clock_speedup_fig4"] >= 100 if _have(r, "virtual_clock_speedup_fig4") else None,

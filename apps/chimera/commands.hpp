@@ -21,6 +21,8 @@ struct VerifyArgs {
 };
 /// `chimera verify FILE [--config NAME]`; returns the exit code.
 int verify_command(const VerifyArgs& args);
+/// chimera __worker ...: a module process of chimera run (docs/processes.md); argv[1] is "__worker".
+int worker_command(int argc, char** argv);
 
 struct RunArgs {
   std::string file;

@@ -4,6 +4,7 @@
 #include <exception>
 #include <memory>
 #include <string>
+#include <string_view>
 
 #include <CLI/CLI.hpp>
 #include <spdlog/cfg/env.h>
@@ -41,6 +42,8 @@ CLI::Validator duration_validator() {
 
 int run_main(int argc, char** argv) {
   log_to_stderr();
+  // A module process of chimera run: not a command for people, so not in the help.
+  if (argc >= 2 && std::string_view(argv[1]) == "__worker") return chimera::cli::worker_command(argc, argv);
 
   CLI::App app{"Dynamically reconfigurable real-time software from port-based objects.", "chimera"};
   app.require_subcommand(1);

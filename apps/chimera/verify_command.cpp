@@ -1,10 +1,14 @@
 // chimera verify FILE [--config NAME]: rules 1 to 3 for every configuration (or one).
 
+#include <algorithm>
 #include <cstdio>
 #include <set>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "chimera/config/loader.hpp"
 #include "chimera/config/verify.hpp"
@@ -15,6 +19,22 @@
 
 namespace chimera::cli {
 
+namespace {
+// "processes: main (robot, pid), vision (vision)": which tasks share a fate (docs/processes.md).
+std::string describe_processes(const SubsystemSpec& spec) {
+  std::vector<std::pair<std::string, std::vector<std::string>>> groups{{std::string(kMainProcess), {}}};
+  for (const auto& t : spec.tasks) {
+    auto it = std::find_if(groups.begin(), groups.end(), [&](const auto& g) { return g.first == t.process; });
+    if (it == groups.end()) it = groups.insert(groups.end(), {t.process, {}});
+    it->second.push_back(t.name);
+  }
+  std::string text = "processes:";
+  for (const auto& [name, tasks] : groups)
+    if (!tasks.empty()) text += fmt::format("{} {} ({})", text.back() == ':' ? "" : ",", name, fmt::join(tasks, ", "));
+  return text;
+}
+}  // namespace
+
 int verify_command(const VerifyArgs& args) {
   const Registry& registry = Registry::global();
   auto spec = load_file(args.file, args.config);
@@ -24,6 +44,7 @@ int verify_command(const VerifyArgs& args) {
   const auto violations = verify_subsystem(resolution, args.config);
   const std::size_t checked = args.config ? 1 : spec->configurations.size();
 
+  if (spec->uses_module_processes()) fmt::print("{}: {}\n", args.file, describe_processes(*spec));
   std::set<std::string> illegal;
   bool file_wide = false;
   for (const auto& v : violations) {

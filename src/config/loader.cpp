@@ -103,6 +103,16 @@ Result<void> read_constants(const Source& source, const MapReader& top, Subsyste
   return {};
 }
 
+// The top-level `process:`: the process of tasks that name none (docs/processes.md).
+Result<void> read_default_process(const Source& source, const MapReader& top, SubsystemSpec& spec) {
+  const auto f = top.get("process");
+  if (!f) return {};
+  auto name = config_detail::read_process_name(source, *f);
+  if (!name) return name.error();
+  spec.default_process = *std::move(name);
+  return {};
+}
+
 Result<void> read_tasks(const Source& source, const MapReader& top, const Registry& registry, SubsystemSpec& spec) {
   auto f = top.require(source, "tasks", "a subsystem needs at least one task");
   if (!f) return f.error();
@@ -192,7 +202,8 @@ Result<MapReader> read_document(const Source& source, std::string_view text) {
                                          config_detail::describe(root.node)));
   return MapReader::create(
       source, root, "the file",
-      {"subsystem", "scheduler", "cpus", "plugins", "constants", "tasks", "configurations", "start", "requests"});
+      {"subsystem", "scheduler", "cpus", "plugins", "constants", "process", "tasks", "configurations", "start",
+       "requests"});
 }
 
 Result<SubsystemSpec> load(const Source& source, std::string_view text, const Registry& registry) {
@@ -209,6 +220,7 @@ Result<SubsystemSpec> load(const Source& source, std::string_view text, const Re
   if (auto ok = read_plugins(source, *top, plugins); !ok) return ok.error();
   for (auto& p : plugins) spec.plugins.push_back(std::move(p.name));
   if (auto ok = read_constants(source, *top, spec); !ok) return ok.error();
+  if (auto ok = read_default_process(source, *top, spec); !ok) return ok.error();
   if (auto ok = read_tasks(source, *top, registry, spec); !ok) return ok.error();
   if (auto ok = read_configurations(source, *top, spec); !ok) return ok.error();
   if (auto ok = read_start(source, *top, spec); !ok) return ok.error();

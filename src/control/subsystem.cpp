@@ -6,6 +6,7 @@
 
 #include <unistd.h>
 
+#include <array>
 #include <mutex>
 #include <shared_mutex>
 #include <utility>
@@ -14,6 +15,7 @@
 
 #include "chimera/svt/global_table.hpp"
 #include "chimera/svt/value_codec.hpp"
+#include "exec/task_block.hpp"
 #include "subsystem_impl.hpp"
 #include "subsystem_test_access.hpp"
 
@@ -45,6 +47,29 @@ Result<void> check_task_cpus(const SubsystemSpec& spec) {
   return {};
 }
 
+namespace {
+
+// How the main process starts its module processes: the chimera binary in its worker mode, told
+// the file, the table and the options of this run.
+ProcessSetup process_setup(const SubsystemSpec& spec, const RunOptions& options, TaskBlock* block,
+                           const std::string& start) {
+  ProcessSetup p;
+  p.block = block;
+  p.worker_program = options.worker_program;
+  if (p.worker_program.empty()) {
+    std::array<char, 4096> self{};
+    const ssize_t n = ::readlink("/proc/self/exe", self.data(), self.size() - 1);
+    p.worker_program = n > 0 ? std::string(self.data(), static_cast<std::size_t>(n)) : "chimera";
+  }
+  p.worker_args = {"--file", spec.file, "--table", spec.name + options.shm_suffix, "--config", start};
+  if (!options.realtime_priorities) p.worker_args.emplace_back("--no-realtime");
+  if (options.measure_cpu_time) p.worker_args.emplace_back("--cpu-time");
+  if (options.rt_check) p.worker_args.emplace_back("--rt-check");
+  return p;
+}
+
+}  // namespace
+
 Result<void> Subsystem::Impl::build_runtime(const std::string& configuration, std::int64_t start_ns) {
   Impl& m = *this;
   const ConfigurationSpec* config = m.spec.find_configuration(configuration);
@@ -71,7 +96,21 @@ Result<void> Subsystem::Impl::build_runtime(const std::string& configuration, st
 
   const ResolvedSubsystem& resolved = m.resolution.subsystem;
   m.requests = std::make_unique<SubsystemRequestBoard>(configuration_names(m.spec), resolved.tasks.size());
-  m.tasks = std::make_unique<TaskSet>(resolved, *m.table, m.requests.get());
+  // Module processes run on the real clock only: the virtual clock simulates every task on one thread.
+  std::vector<TaskShared*> shared;
+  if (m.options.clock == ClockKind::kReal && m.spec.uses_module_processes()) {
+    // A worker loads the subsystem from its file (docs/processes.md): text has none to read.
+    if (::access(m.spec.file.c_str(), R_OK) != 0)
+      return make_error(Errc::kInvalidInput, fmt::format("{}: module processes (process:) need the subsystem loaded "
+                                                         "from a file their workers can read",
+                                                         m.spec.file));
+    auto made = TaskBlock::create(resolved.tasks.size());
+    if (!made) return made.error();
+    m.block = std::make_unique<TaskBlock>(std::move(*made));
+    for (std::size_t i = 0; i < resolved.tasks.size(); ++i)
+      shared.push_back(m.spec.tasks[i].process == kMainProcess ? nullptr : m.block->slot(i));
+  }
+  m.tasks = std::make_unique<TaskSet>(resolved, *m.table, m.requests.get(), shared);
   m.events = std::make_unique<EventLog>(m.tasks->size());
   {
     std::lock_guard<std::mutex> notes(m.notes_mutex);
@@ -90,6 +129,7 @@ Result<void> Subsystem::Impl::build_runtime(const std::string& configuration, st
   setup.configuration = config->tasks;
   setup.events = m.events.get();
   setup.start_ns = start_ns;
+  if (m.block) setup.processes = process_setup(m.spec, m.options, m.block.get(), configuration);
   m.executive = make_executive(std::move(setup));
   m.reconfiguration = std::make_unique<Reconfiguration>(resolved, configuration, *m.requests, *m.tasks,
                                                         *m.executive, *m.table, *m.events);

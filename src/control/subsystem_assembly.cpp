@@ -95,6 +95,11 @@ Result<std::string> Subsystem::add_task(std::string_view entry) {
   {
     std::lock_guard<std::mutex> lock(m.ops_mutex);
     if (m.stopped) return make_error(Errc::kState, "the subsystem is stopped");
+    // A module process reads its tasks from the file: a task the file does not have would shift
+    // every index it shares with the main process (docs/processes.md).
+    if (m.block)
+      return make_error(Errc::kState, "add: not in a subsystem with module processes (process:): their workers "
+                                      "run the tasks of the file as it was started");
     current = live_spec(m);
   }
   auto next = with_task(current, entry, *m.registry);
@@ -149,6 +154,7 @@ Result<std::string> Subsystem::add_task(std::string_view entry) {
       m.executive.reset();
       m.events.reset();
       m.tasks.reset();
+      m.block.reset();
       m.requests.reset();
       m.table.reset();  // the region's name is free again for the new table
       m.spec = *std::move(next);

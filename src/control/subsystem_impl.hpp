@@ -14,6 +14,7 @@
 #include "chimera/svt/global_table.hpp"
 #include "exec/event_log.hpp"
 #include "exec/executive.hpp"
+#include "exec/task_block.hpp"
 #include "exec/task_set.hpp"
 #include "reconfig/reconfiguration.hpp"
 #include "reconfig/request_board.hpp"
@@ -30,6 +31,7 @@ struct Subsystem::Impl {
   Resolution resolution;
   std::unique_ptr<GlobalTable> table;
   std::unique_ptr<SubsystemRequestBoard> requests;
+  std::unique_ptr<TaskBlock> block;  // module processes' tasks' shared slots (docs/processes.md); null: none
   std::unique_ptr<TaskSet> tasks;
   std::unique_ptr<EventLog> events;
   std::unique_ptr<Executive> executive;

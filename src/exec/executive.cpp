@@ -1,5 +1,6 @@
 #include "executive.hpp"
 
+#include "process_executive.hpp"
 #include "real_executive.hpp"
 #include "virtual_executive.hpp"
 
@@ -16,6 +17,7 @@ std::int64_t shortest_period(const std::vector<Task*>& tasks, const SwitchCommit
 std::unique_ptr<Executive> make_executive(ExecutiveSetup setup) {
   // The one place a clock is chosen.
   if (setup.clock == ClockKind::kVirtual) return std::make_unique<VirtualExecutive>(std::move(setup));
+  if (setup.processes.block != nullptr) return std::make_unique<ProcessExecutive>(std::move(setup));
   return std::make_unique<RealExecutive>(std::move(setup));
 }
 

@@ -5,7 +5,8 @@
 // CLOCK_MONOTONIC) and the virtual one (a discrete-event simulation of the same schedule, the
 // tests' oracle), both following release_policy.hpp. The subsystem, the reconfiguration and the
 // control talk only to this interface, and none of them chooses a clock: make_executive() does,
-// once. Tasks whose modules run in another process are to be one more implementation behind it.
+// once. Tasks whose modules run in module processes are behind one more implementation, which
+// routes each signal to the process that runs the task (process_executive.hpp).
 //
 // Exported to the parts above. Nothing here is real-time safe: none of it runs in a cycle.
 
@@ -27,6 +28,15 @@
 
 namespace chimera {
 
+class TaskBlock;
+
+/// What the main process needs to run tasks in module processes (docs/processes.md).
+struct ProcessSetup {
+  TaskBlock* block = nullptr;            // the tasks' shared slots; null: no module processes
+  std::string worker_program;            // the chimera binary
+  std::vector<std::string> worker_args;  // what every worker is told: the file, the table, options
+};
+
 /// What an executive is made from.
 struct ExecutiveSetup {
   ClockKind clock = ClockKind::kReal;
@@ -43,6 +53,14 @@ struct ExecutiveSetup {
   /// The time the executive's clock starts at: 0 for a new subsystem; for one rebuilt by the
   /// live assembly (a task added), the time its clock had reached, so that time goes on.
   std::int64_t start_ns = 0;
+  /// Real clock: which tasks this process runs (empty: all). A module process hosts its own
+  /// tasks; the main process those of no module process (docs/processes.md).
+  std::vector<bool> hosted;
+  /// Real clock: CLOCK_MONOTONIC at time 0 (0: now). A module process takes the main process's,
+  /// so that every process's periodic releases fall on one grid.
+  std::int64_t epoch_ns = 0;
+  /// Real clock, a file with module processes: how to start them (process_executive.hpp).
+  ProcessSetup processes;
 };
 
 /// A switch's commit (docs/reconfiguration.md).
@@ -53,6 +71,12 @@ struct SwitchCommit {
   /// configuration runs on to the next boundary first (the real clock simply took that long).
   bool slow = false;
   std::vector<std::string> target;  // the target configuration's tasks: the plan from the commit on
+  /// The commit's instant on the executive's clock; -1: the next boundary of the fastest task
+  /// involved that leaves time to post it. Given when several executives commit one switch.
+  std::int64_t at_ns = -1;
+  /// Which half to carry out: a switch across module processes makes every leaving task off, in
+  /// every process, before any joining task turns on (one writer per variable at any time).
+  enum class Part : std::uint8_t { kWhole, kLeave, kJoin } part = Part::kWhole;
 };
 
 /// What the subsystem interface asks the executive to serve while it runs.

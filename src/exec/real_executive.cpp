@@ -17,6 +17,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "chimera/core/invariant.hpp"
 #include "chimera/exec/clock.hpp"
 #include "futex.hpp"
 #include "priority_dispatcher.hpp"
@@ -109,10 +110,11 @@ RealExecutive::RealExecutive(ExecutiveSetup setup)
       table_(setup.table),
       events_(setup.events),
       tasks_(std::move(setup.tasks)),
+      hosted_(std::move(setup.hosted)),
       order_(analysis::compute_release_order(subsystem_)),
       plan_(make_schedule_plan(subsystem_, order_, subsystem_cpus(*subsystem_.spec), setup.configuration)),
       cpus_(plan_.cpu),
-      epoch_ns_(monotonic_ns() - setup.start_ns),
+      epoch_ns_(setup.epoch_ns != 0 ? setup.epoch_ns : monotonic_ns() - setup.start_ns),
       realtime_(setup.realtime_priorities) {
   prepare_realtime_process(realtime_);
   for (Task* t : tasks_) {
@@ -159,11 +161,14 @@ void RealExecutive::link_workers() {
       return v && std::ranges::find(i.out_vars, static_cast<int>(*v)) != i.out_vars.end();
     });
   };
+  // Only tasks of one process wait for or wake each other: a task of another process has a
+  // Worker here that never runs (docs/processes.md).
   for (std::size_t i = 0; i < workers_.size(); ++i) {
     for (const int p : order.predecessors[i])
-      workers_[i]->predecessors.push_back(workers_[static_cast<std::size_t>(p)].get());
+      if (hosts(i) && hosts(static_cast<std::size_t>(p)))
+        workers_[i]->predecessors.push_back(workers_[static_cast<std::size_t>(p)].get());
     for (std::size_t j = 0; j < workers_.size(); ++j)
-      if (j != i && !workers_[j]->task->periodic() && reads_from(*workers_[j], *workers_[i]))
+      if (j != i && hosts(i) && hosts(j) && !workers_[j]->task->periodic() && reads_from(*workers_[j], *workers_[i]))
         workers_[i]->subscribers.push_back(workers_[j].get());
   }
 }
@@ -195,7 +200,8 @@ void RealExecutive::form_threads() {
                    [&](std::size_t a, std::size_t b) { return order.rank[a] < order.rank[b]; });
   for (const std::size_t i : by_rank) {
     Worker& w = *workers_[i];
-    const bool groups = w.dispatcher == nullptr && w.task->periodic();
+    // A task this process does not run never shares a thread: its state is another process's.
+    const bool groups = w.dispatcher == nullptr && w.task->periodic() && hosts(i);
     const auto key = std::tuple{w.cpu, w.fixed_priority, w.task->period_ns()};
     TaskThread* t = groups && shared.contains(key) ? shared[key] : nullptr;
     if (t == nullptr) {
@@ -217,13 +223,17 @@ void RealExecutive::shutdown() {
   if (stopped_at_ns_ >= 0) return;
   // The paper's two-step termination: every task off, then every task killed.
   for (std::size_t i = 0; i < workers_.size(); ++i)
-    if (tasks_[i]->state() == TaskState::kOn) (void)signal(i, Signal::kOff);
+    if (hosts(i) && tasks_[i]->state() == TaskState::kOn) (void)signal(i, Signal::kOff);
   for (std::size_t i = 0; i < workers_.size(); ++i) {
     Worker& w = *workers_[i];
-    if (w.thread->running && w.task->state() != TaskState::kNotCreated) (void)signal(i, Signal::kKill);
+    if (hosts(i) && w.thread->running && w.task->state() != TaskState::kNotCreated) (void)signal(i, Signal::kKill);
   }
   for (auto& t : threads_)
     if (t->running) pthread_join(t->handle, nullptr);  // its last member's kill ended it
+  // The dispatchers read the workers' published jobs: they stop here, with no task thread left
+  // to ring them, before the workers can be destroyed (TSAN saw a dispatcher read a freed worker).
+  for (auto& w : workers_) w->dispatcher = nullptr;
+  dispatchers_.clear();
   stopped_at_ns_ = monotonic_ns() - epoch_ns_;
   // A hard job still overdue when the run stopped no longer holds the flag.
   for (std::size_t i = 0; i < overdue_hold_.size(); ++i)
@@ -340,6 +350,7 @@ Result<void> RealExecutive::post_all(const std::vector<std::size_t>& indices, co
 Result<void> RealExecutive::signal(std::size_t index, Signal sig) {
   std::lock_guard<std::mutex> lock(control_mutex_);
   if (stopped_at_ns_ >= 0) return make_error(Errc::kState, "the subsystem is stopped");
+  CHIMERA_INVARIANT(hosts(index), "RealExecutive::signal() to a task another process runs");
   Worker& w = *workers_[index];
   if (!w.thread->running) {
     if (sig != Signal::kSpawn) return w.task->apply(sig, now_ns());  // refused by the state table
@@ -375,50 +386,60 @@ Result<void> RealExecutive::turn_on_together(const std::vector<std::size_t>& ind
   return post_all(joining, joins);
 }
 
+std::int64_t RealExecutive::next_commit_ns(const SwitchCommit& commit) const {
+  // At the next boundary of the fastest task involved that leaves time to post the commit.
+  const std::int64_t shortest = shortest_period(tasks_, commit);
+  const std::int64_t now = now_ns();
+  return shortest > 0 ? release_policy::next_boundary_after(now + kCommitMarginNs, shortest) : now;
+}
+
 Result<void> RealExecutive::commit_switch(const SwitchCommit& commit) {
   const std::vector<std::size_t>& leaving = commit.leaving;
   const std::vector<std::size_t>& joining = commit.joining;
-  SchedulePlan plan = make_schedule_plan(subsystem_, order_, subsystem_cpus(*subsystem_.spec), commit.target);
+  const bool leave_part = commit.part != SwitchCommit::Part::kJoin;
+  const bool join_part = commit.part != SwitchCommit::Part::kLeave;
   Result<void> r;
   {
     std::lock_guard<std::mutex> lock(control_mutex_);
-    // At the next boundary of the fastest task involved that leaves time to post the commit.
-    const std::int64_t shortest = shortest_period(tasks_, commit);
-    const std::int64_t now = now_ns();
-    const std::int64_t commit_ns =
-        shortest > 0 ? release_policy::next_boundary_after(now + kCommitMarginNs, shortest) : now;
+    const std::int64_t commit_ns = commit.at_ns >= 0 ? commit.at_ns : next_commit_ns(commit);
     // Every leaving task answers once it is off: after its last release before the commit. Only
     // then may a joining task turn on, since on() publishes outputs a leaving task wrote: one
     // writer per variable at any time.
     // Successors of the joining tasks must wait for them from the commit's release on, even if
     // the commit runs late: tell them before anything changes.
-    for (const std::size_t i : joining) {
-      Worker& w = *workers_[i];
-      if (w.task->periodic())
-        w.precedence.joining_k.store(release_policy::first_release_index(commit_ns, w.task->period_ns()),
-                                     std::memory_order_release);  // release: pairs with successors' acquire
+    if (leave_part) {
+      for (const std::size_t i : joining) {
+        Worker& w = *workers_[i];
+        if (w.task->periodic())
+          w.precedence.joining_k.store(release_policy::first_release_index(commit_ns, w.task->period_ns()),
+                                       std::memory_order_release);  // release: pairs with successors' acquire
+      }
     }
     // The commit is timed to a cycle boundary: the control thread runs it at a real-time priority
     // above the tasks', so that it is not the one that comes late.
     const ScopedPriority urgent(realtime_, kCommitPriority);
-    const std::vector<Mail> leave(leaving.size(), Mail{MailKind::kLeaveAt, Signal::kOff, epoch_ns_ + commit_ns});
-    r = post_all(leaving, leave);
-    // Each joining task turns on right before its first release from the commit on, on its own
-    // thread: not earlier, since on() publishes outputs a consumer may still be reading the
-    // leaving producer's last value of. Its first release is the commit's even if the commit ran
-    // late (then it runs late): the leaving task ran none from there, and no release may go
-    // unproduced. They are all posted at once and answer as each turns on.
-    std::vector<Mail> join;
-    for (const std::size_t i : joining) {
-      const Worker& w = *workers_[i];
-      const std::int64_t p = w.task->periodic() ? w.task->period_ns() : 1;
-      join.push_back(Mail{MailKind::kOnAt, Signal::kOn, release_policy::first_release_index(commit_ns, p)});
+    if (leave_part) {
+      const std::vector<Mail> leave(leaving.size(), Mail{MailKind::kLeaveAt, Signal::kOff, epoch_ns_ + commit_ns});
+      r = post_all(leaving, leave);
     }
-    if (auto on = post_all(joining, join); r && !on) r = on;
-    for (const std::size_t i : joining)
-      workers_[i]->precedence.joining_k.store(-1, std::memory_order_release);  // scheduled says it now
+    if (join_part) {
+      // Each joining task turns on right before its first release from the commit on, on its own
+      // thread: not earlier, since on() publishes outputs a consumer may still be reading the
+      // leaving producer's last value of. Its first release is the commit's even if the commit ran
+      // late (then it runs late): the leaving task ran none from there, and no release may go
+      // unproduced. They are all posted at once and answer as each turns on.
+      std::vector<Mail> join;
+      for (const std::size_t i : joining) {
+        const Worker& w = *workers_[i];
+        const std::int64_t p = w.task->periodic() ? w.task->period_ns() : 1;
+        join.push_back(Mail{MailKind::kOnAt, Signal::kOn, release_policy::first_release_index(commit_ns, p)});
+      }
+      if (auto on = post_all(joining, join); r && !on) r = on;
+      for (const std::size_t i : joining)
+        workers_[i]->precedence.joining_k.store(-1, std::memory_order_release);  // scheduled says it now
+    }
   }
-  set_plan(std::move(plan));
+  if (join_part) set_plan(make_schedule_plan(subsystem_, order_, subsystem_cpus(*subsystem_.spec), commit.target));
   return r;
 }
 

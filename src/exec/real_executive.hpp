@@ -43,6 +43,8 @@ class RealExecutive final : public Executive {
   Result<void> signal(std::size_t index, Signal sig) override;
   Result<void> turn_on_together(const std::vector<std::size_t>& indices) override;
   Result<void> commit_switch(const SwitchCommit& commit) override;
+  /// The instant a switch posted now would commit at (SwitchCommit::at_ns). Not real-time safe.
+  [[nodiscard]] std::int64_t next_commit_ns(const SwitchCommit& commit) const;
   Result<void> reinit(std::size_t index) override;
   void run_for(std::int64_t ns) override;
   void serve(ServiceHooks hooks) override;
@@ -55,6 +57,8 @@ class RealExecutive final : public Executive {
   [[nodiscard]] const GlobalTable& table() const { return *table_; }
   /// The SCHED_FIFO priority task `index` starts at (its fixed priority under rm and dm).
   [[nodiscard]] int fixed_priority(std::size_t index) const;
+  /// Whether this process runs task `index` (ExecutiveSetup::hosted). Any thread.
+  [[nodiscard]] bool hosts(std::size_t index) const noexcept { return hosted_.empty() || hosted_[index]; }
   /// The absolute deadline (executive clock) of the job task `index` is running now, if it is
   /// running one with a deadline; it names the job. Any thread; wait-free.
   [[nodiscard]] std::optional<std::int64_t> running_deadline(std::size_t index) const noexcept;
@@ -85,10 +89,11 @@ class RealExecutive final : public Executive {
   GlobalTable* table_;
   EventLog* events_;
   std::vector<Task*> tasks_;
+  const std::vector<bool> hosted_;  // empty: every task
   analysis::ReleaseOrder order_;
   SchedulePlan plan_;
   const std::vector<int> cpus_;  // plan_.cpu as it was made: a switch never moves a task, so any thread may read it
-  std::vector<std::unique_ptr<PriorityDispatcher>> dispatchers_;  // outlive the workers that poke them
+  std::vector<std::unique_ptr<PriorityDispatcher>> dispatchers_;  // stopped by shutdown(), before the workers go
   std::vector<std::unique_ptr<Worker>> workers_;
   std::vector<std::unique_ptr<TaskThread>> threads_;
   std::int64_t epoch_ns_ = 0;

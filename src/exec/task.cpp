@@ -23,15 +23,26 @@ const char* hook_name(std::uint8_t hook) {
 }
 }  // namespace
 
-Task::Task(const ResolvedTask& resolved, GlobalTable& table, const SubsystemFlags& flags)
-    : spec_(*resolved.spec), resolved_(resolved), table_(table), flags_(flags) {
+const char* busy_in_name(BusyIn method) noexcept {
+  static constexpr std::array<const char*, 7> kNames = {"init", "on", "cycle", "off", "kill", "clear", "reinit"};
+  return kNames[static_cast<std::size_t>(method)];
+}
+
+Task::Task(const ResolvedTask& resolved, GlobalTable& table, const SubsystemFlags& flags, TaskShared* shared)
+    : spec_(*resolved.spec),
+      resolved_(resolved),
+      table_(table),
+      flags_(flags),
+      own_shared_(shared == nullptr ? std::make_unique<TaskShared>() : nullptr),
+      shared_(shared == nullptr ? own_shared_.get() : shared) {
   timing_.period_ns = spec_.period_ns.value_or(0);
 }
 
 Task::~Task() {
   // A destructor must not throw: the kill's message (a std::string) could fail to allocate.
   try {
-    if (state() != TaskState::kNotCreated) (void)apply(Signal::kKill, timing_.release_ns);
+    // A view of a task run by another process has no module here: that process kills it.
+    if (module_ != nullptr && state() != TaskState::kNotCreated) (void)apply(Signal::kKill, timing_.release_ns);
   } catch (...) {
     destroy_module();
   }
@@ -48,8 +59,8 @@ Status Task::call_raw(Hook hook) noexcept {
 
 void Task::note_rt_allocation() noexcept {
   // Once per task: a cycle that allocates does so every cycle, and the count tells the rest.
-  if (stats_.record_rt_allocation())
-    events_.push(timing_.release_ns, hook_name(static_cast<std::uint8_t>(rt_hook_)),
+  if (shared_->stats.record_rt_allocation())
+    shared_->events.push(timing_.release_ns, hook_name(static_cast<std::uint8_t>(rt_hook_)),
                  "() allocated on the real-time path (--rt-check)");
 }
 
@@ -85,16 +96,16 @@ Status Task::call(Hook hook) noexcept {
 }
 
 bool Task::recover(Hook hook, Status failure, std::int64_t now_ns) noexcept {
-  events_.push(now_ns, hook_name(static_cast<std::uint8_t>(hook)), " failed: ", failure.reason());
+  shared_->events.push(now_ns, hook_name(static_cast<std::uint8_t>(hook)), " failed: ", failure.reason());
   timing_.fault = Fault::kMethodFailed;
   const Status handled = call(Hook::kError);
   timing_.fault = Fault::kNone;
   if (handled.is_ok()) {
-    events_.push(now_ns, "error() recovered", nullptr);
+    shared_->events.push(now_ns, "error() recovered", nullptr);
     return true;
   }
   set_state(TaskState::kError);
-  events_.push(now_ns, "ERROR: operator intervention required (clear): ", failure.reason());
+  shared_->events.push(now_ns, "ERROR: operator intervention required (clear): ", failure.reason());
   return false;
 }
 
@@ -115,6 +126,7 @@ std::int64_t Task::begin_job(std::int64_t release_ns, std::int64_t start_ns) noe
   timing_.release_ns = release_ns;
   timing_.start_ns = start_ns;
   job_ = Job{true, false, release_ns, start_ns, exec_clock_now()};
+  const BusyScope busy(*shared_, BusyIn::kCycle, start_ns);
   module_->virtual_ns_ = 0;
   local_->pull_in_vars();
   // An aperiodic task first takes its event from the resource port, then processes it.
@@ -143,8 +155,8 @@ std::int64_t Task::end_job(std::int64_t end_ns, std::int64_t used_ns) noexcept {
   if (!simulated) used_ns = host_ns;
   const bool missed = end_ns > absolute_deadline(job_.release_ns);
   const bool overrun = spec_.wcet_ns.has_value() && used_ns > *spec_.wcet_ns;
-  stats_.record_cycle(job_.start_ns - job_.release_ns, used_ns, end_ns - job_.release_ns, missed, overrun);
-  if (simulated) stats_.record_host_exec(host_ns);
+  shared_->stats.record_cycle(job_.start_ns - job_.release_ns, used_ns, end_ns - job_.release_ns, missed, overrun);
+  if (simulated) shared_->stats.record_host_exec(host_ns);
   ++timing_.cycle;
   if ((missed || overrun) && hard() && state() == TaskState::kOn)
     timing_fault(missed ? Fault::kDeadlineMissed : Fault::kBudgetOverrun, end_ns);
@@ -167,6 +179,7 @@ bool Task::reinit(std::int64_t now_ns) noexcept {
   if (state() != TaskState::kOn) return false;
   local_->pull_in_consts();
   reinits_.fetch_add(1, std::memory_order_relaxed);  // a counter read on its own
+  const BusyScope busy(*shared_, BusyIn::kReinit, now_ns);
   const Status s = call(Hook::kReinit);
   if (!s.is_ok() && !recover(Hook::kReinit, s, now_ns)) return false;
   return state() == TaskState::kOn;
@@ -174,7 +187,7 @@ bool Task::reinit(std::int64_t now_ns) noexcept {
 
 void Task::skip_releases(std::uint64_t n, std::int64_t now_ns) noexcept {
   if (n == 0) return;
-  stats_.record_skipped(n);
+  shared_->stats.record_skipped(n);
   if (hard() && state() == TaskState::kOn) timing_fault(Fault::kDeadlineMissed, now_ns);
 }
 
@@ -192,25 +205,25 @@ void Task::timing_fault(Fault fault, std::int64_t now_ns) noexcept {
       const auto [end, ec] = std::to_chars(count.data(), count.data() + count.size() - 1, timing_faults_);
       *end = '\0';
       (void)ec;  // 24 characters hold any 64-bit count
-      events_.push(now_ns, what, "; error() recovered; timing faults so far: ", count.data());
+      shared_->events.push(now_ns, what, "; error() recovered; timing faults so far: ", count.data());
     }
     return;
   }
   set_state(TaskState::kError);
-  events_.push(now_ns, "ERROR: operator intervention required (clear): ", what);
+  shared_->events.push(now_ns, "ERROR: operator intervention required (clear): ", what);
 }
 
 void Task::set_state(TaskState s) noexcept {
   // Only the thread carrying out this task's methods changes its state, so `before` is current.
-  const TaskState before = state_.load(std::memory_order_relaxed);
+  const TaskState before = shared_->state.load(std::memory_order_relaxed);
   // The paper's flag also marks an error in the subsystem, so that critical modules keep the
   // system safe: a task in ERROR holds it, from before its state says ERROR until after it no
   // longer does, so whoever sees the task in ERROR sees the flag up.
   if (s == TaskState::kError && before != TaskState::kError) {
-    ever_in_error_.store(true, std::memory_order_relaxed);  // a latch, read on its own
+    shared_->ever_in_error.store(true, std::memory_order_relaxed);  // a latch, read on its own
     table_.raise_illegal_configuration();
   }
-  state_.store(s, std::memory_order_release);  // release: what the method did is visible to whoever sees the state
+  shared_->state.store(s, std::memory_order_release);  // release: what the method did is visible to whoever sees the state
   if (before == TaskState::kError && s != TaskState::kError) table_.lower_illegal_configuration();
 }
 
@@ -219,6 +232,8 @@ Result<void> Task::apply(Signal signal, std::int64_t now_ns) {
   if (!transition(from, signal))
     return make_error(Errc::kState, fmt::format("{}: cannot {} a task that is {}", spec_.name, signal_name(signal),
                                                 state_name(from)));
+  static constexpr BusyIn kMethodOf[] = {BusyIn::kInit, BusyIn::kOn, BusyIn::kOff, BusyIn::kKill, BusyIn::kClear};
+  const BusyScope busy(*shared_, kMethodOf[static_cast<std::size_t>(signal)], now_ns);
   switch (signal) {
     case Signal::kSpawn: return spawn(now_ns);
     case Signal::kOn: return turn_on(now_ns);
@@ -263,7 +278,7 @@ Result<void> Task::spawn(std::int64_t now_ns) {
     // The paper's rule: an error in init prevents creation and calls kill to free what init took.
     (void)call_raw(Hook::kKill);
     destroy_module();
-    events_.push(now_ns, "init failed; task not created: ", reason.c_str());
+    shared_->events.push(now_ns, "init failed; task not created: ", reason.c_str());
     return make_error(Errc::kModuleFault, fmt::format("{}: init failed: {}", spec_.name, reason));
   }
   // Publishing what init produced lets consumers start from real values; not while another
@@ -274,7 +289,7 @@ Result<void> Task::spawn(std::int64_t now_ns) {
     local_->push_out_vars();
   }
   if (!periodic() && !trigger_.any())
-    events_.push(now_ns, "aperiodic, and its module declared no trigger in init: it will never cycle", nullptr);
+    shared_->events.push(now_ns, "aperiodic, and its module declared no trigger in init: it will never cycle", nullptr);
   trigger_var_ = -1;
   if (!trigger_.update_port.empty()) {
     for (const auto& b : resolved_.bindings)
@@ -329,7 +344,7 @@ Result<void> Task::kill(std::int64_t now_ns) {
   destroy_module();
   set_state(TaskState::kNotCreated);
   if (!problem.empty()) {
-    events_.push(now_ns, "killed with a fault: ", problem.c_str());
+    shared_->events.push(now_ns, "killed with a fault: ", problem.c_str());
     return make_error(Errc::kModuleFault, fmt::format("{}: {} (task destroyed)", spec_.name, problem));
   }
   return {};
@@ -338,12 +353,28 @@ Result<void> Task::kill(std::int64_t now_ns) {
 Result<void> Task::clear(std::int64_t now_ns) {
   const Status s = call(Hook::kClear);
   if (!s.is_ok()) {
-    events_.push(now_ns, "clear refused; still in ERROR: ", s.reason());
+    shared_->events.push(now_ns, "clear refused; still in ERROR: ", s.reason());
     return make_error(Errc::kModuleFault,
                       fmt::format("{}: clear failed: {}; task stays in ERROR", spec_.name, s.reason()));
   }
   set_state(TaskState::kOff);
   return {};
+}
+
+void Task::lose_process(const char* reason, std::int64_t now_ns) noexcept {
+  // The dead process may have died inside a method: its heartbeat must not outlive it.
+  shared_->busy_since_ns.store(TaskShared::kIdle, std::memory_order_release);  // release: as in BusyScope
+  const TaskState before = state();
+  if (before == TaskState::kNotCreated) return;
+  if (before != TaskState::kError) set_state(TaskState::kError);
+  shared_->events.push(now_ns, "ERROR: ", reason, "; operator intervention required (clear)");
+}
+
+bool Task::forget_lost_process() noexcept {
+  const TaskState before = state();
+  if (before == TaskState::kNotCreated) return false;
+  set_state(TaskState::kNotCreated);  // from ERROR: gives the hold back
+  return true;
 }
 
 void Task::destroy_module() noexcept {

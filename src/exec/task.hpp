@@ -28,14 +28,17 @@
 #include "chimera/svt/global_table.hpp"
 #include "chimera/svt/local_table.hpp"
 #include "event_ring.hpp"
+#include "task_shared.hpp"
 
 namespace chimera {
 
 class Task {
  public:
-  static constexpr std::size_t kEventCapacity = 64;
+  static constexpr std::size_t kEventCapacity = TaskShared::kEventCapacity;
 
-  Task(const ResolvedTask& resolved, GlobalTable& table, const SubsystemFlags& flags);
+  /// `shared`: where its state, statistics and events live when other processes must see them
+  /// (a slot of the task block, docs/processes.md); nullptr: in the task's own memory.
+  Task(const ResolvedTask& resolved, GlobalTable& table, const SubsystemFlags& flags, TaskShared* shared = nullptr);
   /// Whether the task has an in-const bound to variable `name`.
   [[nodiscard]] bool reads_const(std::string_view name) const;
   /// The names of the variables its out-consts are bound to.
@@ -52,7 +55,7 @@ class Task {
   [[nodiscard]] bool hard() const { return spec_.criticality == Criticality::kHard; }
 
   /// Current lifecycle state. Real-time safe, any thread.
-  [[nodiscard]] TaskState state() const noexcept { return state_.load(std::memory_order_acquire); }
+  [[nodiscard]] TaskState state() const noexcept { return shared_->state.load(std::memory_order_acquire); }
 
   /// Carries out a lifecycle signal: spawn calls init (allocation allowed), on calls on, off
   /// calls off, kill calls off if ON then kill, clear calls clear. `now_ns` stamps events.
@@ -111,12 +114,23 @@ class Task {
   /// Where its module's switch requests go, and its index there (set before spawn).
   void set_request_board(RequestBoard* board, int index) noexcept { services_ = {board, index}; }
 
-  [[nodiscard]] const TaskStats& stats() const { return stats_; }
+  [[nodiscard]] const TaskStats& stats() const { return shared_->stats; }
   /// The executive gave up waiting for a same-rate producer. Real-time safe.
-  void record_order_timeout() noexcept { stats_.record_order_timeout(); }
-  [[nodiscard]] EventRing<kEventCapacity>& events() { return events_; }
+  void record_order_timeout() noexcept { shared_->stats.record_order_timeout(); }
+  [[nodiscard]] EventRing<kEventCapacity>& events() { return shared_->events; }
   /// Whether this task has entered ERROR at least once. Any thread.
-  [[nodiscard]] bool ever_in_error() const noexcept { return ever_in_error_.load(std::memory_order_relaxed); }
+  [[nodiscard]] bool ever_in_error() const noexcept {
+    return shared_->ever_in_error.load(std::memory_order_relaxed);  // a latch, read on its own
+  }
+
+  /// The main process's view of a task whose module process has died (docs/processes.md): a task
+  /// that existed goes to ERROR (holding the flag, as every task in ERROR does) with an event
+  /// giving `reason`; one already in ERROR keeps its hold. Only once the dead process can no longer
+  /// write the task's shared state, from the one thread that handles the death. Not real-time safe.
+  void lose_process(const char* reason, std::int64_t now_ns) noexcept;
+  /// Before its process starts again: the task is NOT CREATED (its hold on the flag given back),
+  /// ready to be spawned by the new process. Returns whether it existed. Not real-time safe.
+  bool forget_lost_process() noexcept;
   /// Timing seen by the module through InitContext::timing().
   [[nodiscard]] const CycleTiming& timing() const { return timing_; }
 
@@ -168,12 +182,10 @@ class Task {
   } job_;
   std::uint64_t timing_faults_ = 0;  // recovered ones too: events are sent at 1, 2, 4, 8...
   std::atomic<std::uint64_t> reinits_{0};
-  TaskStats stats_;
-  EventRing<kEventCapacity> events_;
   std::array<char, 160> exception_text_{};
 
-  alignas(64) std::atomic<TaskState> state_{TaskState::kNotCreated};
-  std::atomic<bool> ever_in_error_{false};
+  std::unique_ptr<TaskShared> own_shared_;  // when `shared` was not given
+  TaskShared* shared_;
 };
 
 }  // namespace chimera

@@ -2,9 +2,12 @@
 
 namespace chimera {
 
-TaskSet::TaskSet(const ResolvedSubsystem& subsystem, GlobalTable& table, RequestBoard* requests) : flags_(table) {
+TaskSet::TaskSet(const ResolvedSubsystem& subsystem, GlobalTable& table, RequestBoard* requests,
+                 const std::vector<TaskShared*>& shared)
+    : flags_(table) {
   for (const auto& resolved : subsystem.tasks) {
-    tasks_.push_back(std::make_unique<Task>(resolved, table, flags_));
+    const std::size_t i = tasks_.size();
+    tasks_.push_back(std::make_unique<Task>(resolved, table, flags_, i < shared.size() ? shared[i] : nullptr));
     tasks_.back()->set_request_board(requests, static_cast<int>(tasks_.size() - 1));
   }
 }

@@ -19,8 +19,10 @@ namespace chimera {
 class TaskSet {
  public:
   /// One Task per task of `subsystem`, on `table`; a module's switch requests go to `requests`
-  /// (may be null).
-  TaskSet(const ResolvedSubsystem& subsystem, GlobalTable& table, RequestBoard* requests);
+  /// (may be null). `shared[i]`, where given and not null, is where task i keeps what other
+  /// processes see of it (task_shared.hpp).
+  TaskSet(const ResolvedSubsystem& subsystem, GlobalTable& table, RequestBoard* requests,
+          const std::vector<TaskShared*>& shared = {});
 
   [[nodiscard]] std::size_t size() const noexcept { return tasks_.size(); }
   [[nodiscard]] Task& operator[](std::size_t i) noexcept { return *tasks_[i]; }

@@ -36,6 +36,9 @@ struct SourceLoc {
   int line = 0;  // 1-based; 0 when unknown
 };
 
+/// The process name of the `chimera run` process itself (docs/processes.md).
+inline constexpr std::string_view kMainProcess = "main";
+
 struct TaskSpec {
   std::string name;                       // instance name, unique in the file
   std::string module;                     // module type in the registry
@@ -50,6 +53,9 @@ struct TaskSpec {
   std::optional<ServerSpec> server;    // aperiodic tasks only
   Params params;
   std::map<std::string, std::string> rename;  // port name -> variable name
+  /// The OS process its module runs in (docs/processes.md): kMainProcess, the chimera run
+  /// process itself, unless the file names a module process.
+  std::string process{kMainProcess};
   SourceLoc loc;
 
   /// The variable that port `port` is bound to after renaming.
@@ -85,6 +91,14 @@ struct SubsystemSpec {
   std::vector<ConfigurationSpec> configurations;
   std::string start;  // a configuration name; the loader fills in the first when absent
   std::vector<SwitchRequestSpec> requests;
+  std::string default_process{kMainProcess};  // top-level `process:`, the default of tasks without one
+
+  /// Whether some task runs in a module process (a process other than main).
+  [[nodiscard]] bool uses_module_processes() const {
+    for (const auto& t : tasks)
+      if (t.process != kMainProcess) return true;
+    return false;
+  }
 
   /// The entry that lets task `by` ask for `to` while `from` is on, or nullptr.
   [[nodiscard]] const SwitchRequestSpec* find_request(std::string_view from, std::string_view to,

@@ -38,6 +38,9 @@ struct RunOptions {
   /// --rt-check`). Only a program that installs the allocator hook of chimera/exec/rt_check.hpp
   /// sees any: the chimera command does; elsewhere the counts stay 0.
   bool rt_check = false;
+  /// Real clock, a file with module processes (docs/processes.md): the chimera binary that runs
+  /// them ("": this program, /proc/self/exe). A program that is not chimera names it.
+  std::string worker_program;
 };
 
 /// One task as the subsystem interface sees it.

@@ -224,7 +224,7 @@ Result<TaskSpec> load_task(const Source& source, const Field& task_field, const 
                            const Registry& registry) {
   auto map = MapReader::create(source, task_field, "a task",
                                {"name", "module", "period", "frequency", "deadline", "criticality", "wcet", "cpu",
-                                "priority", "late", "virtual_exec", "server", "params", "rename"});
+                                "priority", "late", "virtual_exec", "server", "params", "rename", "process"});
   if (!map) return map.error();
   TaskSpec task;
   task.loc = SourceLoc{source.file(), task_field.line};
@@ -247,6 +247,12 @@ Result<TaskSpec> load_task(const Source& source, const Field& task_field, const 
   if (auto ok = read_criticality(source, *map, task); !ok) return ok.error();
   if (auto ok = read_scheduling(source, *map, task); !ok) return ok.error();
   if (auto ok = read_cpu(source, *map, file.cpus, task); !ok) return ok.error();
+  task.process = file.default_process;
+  if (const auto process = map->get("process")) {
+    auto process_name = read_process_name(source, *process);
+    if (!process_name) return process_name.error();
+    task.process = *std::move(process_name);
+  }
   auto params = read_params(source, map->get("params"), **info);
   if (!params) return params.error();
   task.params = *std::move(params);

@@ -141,6 +141,15 @@ Result<std::string> read_identifier(const Source& source, const Field& field, st
   return text;
 }
 
+Result<std::string> read_process_name(const Source& source, const Field& field) {
+  auto name = read_identifier(source, field, "process name");
+  if (!name) return name.error();
+  // It travels on a worker's command line and into its messages: keep it short.
+  if (name->size() > kMaxProcessName)
+    return source.fail(field, fmt::format("\"{}\" is longer than {} characters", *name, kMaxProcessName));
+  return name;
+}
+
 Result<double> read_number(const Source& source, const Field& field) {
   if (auto v = as_number(field.node)) return *v;
   return source.fail(field, fmt::format("{} is not a number", describe(field.node)));

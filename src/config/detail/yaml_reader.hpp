@@ -77,6 +77,9 @@ std::optional<bool> as_bool(const YAML::Node& node);
 
 Result<std::string> read_text(const Source& source, const Field& field);
 Result<std::string> read_identifier(const Source& source, const Field& field, std::string_view what);
+/// A `process:` name (docs/processes.md): an identifier of at most kMaxProcessName characters.
+Result<std::string> read_process_name(const Source& source, const Field& field);
+inline constexpr std::size_t kMaxProcessName = 40;
 Result<double> read_number(const Source& source, const Field& field);
 /// A whole number >= 0 (CPU indices).
 Result<int> read_index(const Source& source, const Field& field);

@@ -28,6 +28,8 @@ class ChimeraProcess {
   /// Waits up to `timeout_ms` for the exit; the exit code, or -1 (then the process is killed).
   int wait_exit(int timeout_ms = 30000);
   [[nodiscard]] bool running();
+  /// Its pid while it runs (-1 once reaped).
+  [[nodiscard]] int pid() const { return pid_; }
 
   [[nodiscard]] std::string out() const;
   [[nodiscard]] std::string err() const;

@@ -47,8 +47,8 @@ TEST(LoaderErrors, MoreThanOneDocument) {
 
 TEST(LoaderErrors, UnknownTopLevelKey) {
   EXPECT_EQ(error_of(std::string("subsystem: s\nschedular: rm\n") + kOneTask),
-            "pid.yaml:2: schedular: unknown key (known: subsystem, scheduler, cpus, plugins, constants, tasks, "
-            "configurations, start, requests)");
+            "pid.yaml:2: schedular: unknown key (known: subsystem, scheduler, cpus, plugins, constants, process, "
+            "tasks, configurations, start, requests)");
 }
 
 TEST(LoaderErrors, KeyWrittenTwice) {
@@ -131,7 +131,7 @@ tasks:
     perod: 10ms
 )"),
             "pid.yaml:5: tasks[0].perod: unknown key (known: name, module, period, frequency, deadline, criticality, "
-            "wcet, cpu, priority, late, virtual_exec, server, params, rename)");
+            "wcet, cpu, priority, late, virtual_exec, server, params, rename, process)");
 }
 
 TEST(LoaderErrors, MissingNameOrModule) {
@@ -278,6 +278,22 @@ TEST(LoaderErrors, BadCpu) {
             "pid.yaml:3: tasks[0].cpu: \"-2\" is not a CPU number (a whole number >= 0)");
   EXPECT_EQ(error_of("subsystem: s\ncpus: [0, 1]\ntasks:\n  - name: a\n    module: visual_servo\n    cpu: 2\n"),
             "pid.yaml:6: tasks[0].cpu: cpu 2 is not one of the subsystem's cpus [0, 1]");
+}
+
+TEST(LoaderErrors, BadProcess) {
+  EXPECT_EQ(error_of("subsystem: s\ntasks:\n  - {name: a, module: visual_servo, process: 2d}\n"),
+            "pid.yaml:3: tasks[0].process: \"2d\" is not a valid process name (letters, digits and _, not starting "
+            "with a digit)");
+  EXPECT_EQ(error_of("subsystem: s\ntasks:\n  - name: a\n    module: visual_servo\n    process: [a, b]\n"),
+            "pid.yaml:5: tasks[0].process: needs a text value, not a list");
+  EXPECT_EQ(error_of(std::string("subsystem: s\nprocess: vision-1\n") + kOneTask),
+            "pid.yaml:2: process: \"vision-1\" is not a valid process name (letters, digits and _, not starting "
+            "with a digit)");
+  EXPECT_EQ(error_of(std::string("subsystem: s\nprocess:\n") + kOneTask),
+            "pid.yaml:2: process: needs a text value, not nothing");
+  const std::string long_name(41, 'p');
+  EXPECT_EQ(error_of("subsystem: s\ntasks:\n  - {name: a, module: visual_servo, process: " + long_name + "}\n"),
+            "pid.yaml:3: tasks[0].process: \"" + long_name + "\" is longer than 40 characters");
 }
 
 }  // namespace

@@ -58,6 +58,27 @@ TEST(LoadSubsystem, Figure4FileAndItsDefaults) {
   EXPECT_EQ(s.start, "default");
 }
 
+TEST(LoadSubsystem, ProcessesAndTheirDefault) {
+  // No process: anywhere: every task in the chimera run process, as before.
+  const SubsystemSpec plain = load_ok("subsystem: s\ntasks:\n  - {name: a, module: visual_servo}\n");
+  EXPECT_EQ(plain.default_process, "main");
+  EXPECT_EQ(plain.tasks[0].process, "main");
+  EXPECT_FALSE(plain.uses_module_processes());
+  // A task's own process:, and the top-level default for the others.
+  const SubsystemSpec s = load_ok(R"(subsystem: s
+process: vision
+tasks:
+  - {name: a, module: visual_servo}
+  - {name: b, module: visual_servo, process: main}
+  - {name: c, module: visual_servo, process: crashy}
+)");
+  EXPECT_EQ(s.default_process, "vision");
+  EXPECT_EQ(s.tasks[0].process, "vision");
+  EXPECT_EQ(s.tasks[1].process, "main");
+  EXPECT_EQ(s.tasks[2].process, "crashy");
+  EXPECT_TRUE(s.uses_module_processes());
+}
+
 TEST(LoadSubsystem, Figures8And9File) {
   auto r = load_subsystem_file(kData + "/figures8_9.yaml", registry());
   ASSERT_TRUE(r.ok()) << r.error().message;

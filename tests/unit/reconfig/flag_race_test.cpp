@@ -64,10 +64,11 @@ bool eventually(Predicate p) {
 
 TaskState state_of(Subsystem& s, const std::string& task) { return testing::task_of(s, task).state; }
 
-// `faulty` fails in its cycle after 20 cycles and does not recover: ERROR on its own thread.
+// `faulty` fails in its cycle after 500 cycles and does not recover: ERROR on its own thread. Late
+// enough that the switch (refused once a task is in ERROR) is under way first, even in a TSAN build.
 const std::string kGated = R"(subsystem: flagrace
 tasks:
-  - {name: faulty, module: probe, period: 1ms, criticality: soft, params: {fail: cycle, fail_after: 20}}
+  - {name: faulty, module: probe, period: 1ms, criticality: soft, params: {fail: cycle, fail_after: 500}}
   - {name: gate, module: gate, period: 1ms, criticality: soft}
 configurations:
   plain: [faulty]

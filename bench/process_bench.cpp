@@ -1,0 +1,220 @@
+// Module processes on the real clock (issue 15, item 7), side by side in one run:
+//  1. Figure 4's loop (traj, pid, robot, monitor at 1 kHz) all in the chimera process, against
+//     the same file with the PID in a module process of its own; runs alternate. Per run: every
+//     task's release latency p50 and p99 (the worst task's is the run's), each task's mean cycle
+//     (the framework's transfers and bookkeeping plus the module), cycles run and misses.
+//  2. A module process's death seen as ERROR: the PID's process killed by SIGKILL at a known
+//     instant, then the time until the illegal-configuration flag is up with the task in ERROR
+//     (goal: within one period of the fastest task, 1 ms); then the time from `clear` to ON again
+//     (clear starts the process anew, on turns the task on).
+//
+//   process_bench [--quick] [--out FILE] [--worker PATH]
+//
+// Keys: process_fig4_latency_p50_ratio, process_fig4_latency_p99_ratio (PID in its own process
+// over all in one), process_death_to_error_ns_p50/_max, process_clear_to_on_ns_p50/_max.
+
+#include <signal.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdint>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "chimera/config/loader.hpp"
+#include "chimera/control/subsystem.hpp"
+#include "common/bench_util.hpp"
+
+namespace chimera::bench {
+namespace {
+
+constexpr std::int64_t kMs = 1'000'000;
+
+std::string fig4(bool pid_apart) {
+  return std::string("subsystem: process_bench\n"
+                     "scheduler: rm\n"
+                     "tasks:\n"
+                     "  - {name: traj, module: joint_traj_gen, period: 1ms, criticality: soft}\n"
+                     "  - {name: pid, module: pid_joint, period: 1ms") +
+         (pid_apart ? ", process: control" : "") +
+         "}\n"
+         "  - {name: robot, module: robot_torque, period: 1ms}\n"
+         "  - {name: monitor, module: tracking_monitor, period: 1ms, criticality: soft}\n";
+}
+
+Result<std::unique_ptr<Subsystem>> make(bool pid_apart, const std::string& worker) {
+  // A file, not text: a module process reads the file its subsystem was loaded from.
+  const std::string path = fmt::format("/tmp/process_bench_{}.yaml", ::getpid());
+  std::ofstream(path) << fig4(pid_apart);
+  auto spec = load_subsystem_file(path, Registry::global());  // read again by the worker: kept to the end
+  if (!spec) return spec.error();
+  RunOptions options;
+  options.clock = ClockKind::kReal;
+  options.worker_program = worker;
+  return Subsystem::create(*spec, Registry::global(), options);
+}
+
+const TaskSnapshot* find(const std::vector<TaskSnapshot>& all, const std::string& name) {
+  for (const auto& t : all)
+    if (t.name == name) return &t;
+  return nullptr;
+}
+
+struct LoopRun {
+  std::int64_t latency_p50_ns = 0;  // the worst task's
+  std::int64_t latency_p99_ns = 0;
+  std::uint64_t cycles = 0;
+  std::uint64_t missed = 0;
+  nlohmann::json tasks;
+};
+
+Result<LoopRun> run_loop(bool pid_apart, const std::string& worker, std::int64_t ns) {
+  auto made = make(pid_apart, worker);
+  if (!made) return made.error();
+  Subsystem& s = **made;
+  if (auto started = s.start(); !started) return started.error();
+  s.run_for(ns);
+  LoopRun r;
+  for (const auto& t : s.snapshot()) {
+    r.latency_p50_ns = std::max(r.latency_p50_ns, t.stats.latency_p50_ns);
+    r.latency_p99_ns = std::max(r.latency_p99_ns, t.stats.latency_p99_ns);
+    r.cycles += t.stats.cycles;
+    r.missed += t.stats.missed;
+    r.tasks[t.name] = {{"cycles", t.stats.cycles},
+                       {"missed", t.stats.missed},
+                       {"latency_p50_ns", t.stats.latency_p50_ns},
+                       {"latency_p99_ns", t.stats.latency_p99_ns},
+                       {"exec_mean_ns", t.stats.exec_mean_ns},
+                       {"state", std::string(state_name(t.state))}};
+  }
+  s.stop();
+  return r;
+}
+
+// The module process of this process (the only child that is a chimera worker).
+pid_t worker_pid() {
+  std::ifstream in(fmt::format("/proc/self/task/{}/children", ::getpid()));
+  pid_t child = -1;
+  in >> child;
+  return child;
+}
+
+struct Recovery {
+  std::vector<std::int64_t> death_to_error_ns;
+  std::vector<std::int64_t> clear_to_on_ns;
+  std::string error;
+};
+
+Recovery kill_and_clear(const std::string& worker, int kills) {
+  Recovery out;
+  auto made = make(true, worker);
+  if (!made) return {{}, {}, made.error().message};
+  Subsystem& s = **made;
+  if (auto started = s.start(); !started) return {{}, {}, started.error().message};
+  s.run_for(200 * kMs);
+  for (int k = 0; k < kills; ++k) {
+    const pid_t victim = worker_pid();
+    if (victim <= 0) return {out.death_to_error_ns, out.clear_to_on_ns, "no module process to kill"};
+    const std::int64_t killed_at = monotonic_ns();
+    ::kill(victim, SIGKILL);
+    // The flag is cheap to read; the task's state is confirmed once it is up. A short sleep
+    // between looks, so that this thread does not take a CPU from the ones it is timing.
+    while (!s.illegal_configuration() && monotonic_ns() - killed_at < 5'000 * kMs) {
+      const timespec pause{0, 20'000};
+      ::nanosleep(&pause, nullptr);
+    }
+    const std::int64_t seen_at = monotonic_ns();
+    const TaskSnapshot* pid = find(s.snapshot(), "pid");
+    if (pid == nullptr || pid->state != TaskState::kError)
+      return {out.death_to_error_ns, out.clear_to_on_ns, "the PID is not in ERROR after its process was killed"};
+    out.death_to_error_ns.push_back(seen_at - killed_at);
+    s.run_for(50 * kMs);
+    const std::int64_t clear_at = monotonic_ns();
+    if (auto cleared = s.signal("pid", Signal::kClear); !cleared) return {{}, {}, cleared.error().message};
+    if (auto on = s.signal("pid", Signal::kOn); !on) return {{}, {}, on.error().message};
+    out.clear_to_on_ns.push_back(monotonic_ns() - clear_at);
+    if (s.illegal_configuration()) return {out.death_to_error_ns, out.clear_to_on_ns, "the flag stayed up after clear"};
+    s.run_for(100 * kMs);
+  }
+  s.stop();
+  return out;
+}
+
+std::string worker_arg(const Args& args) {
+  for (std::size_t i = 0; i + 1 < args.rest.size(); ++i)
+    if (args.rest[i] == "--worker") return args.rest[i + 1];
+  return CHIMERA_BIN;
+}
+
+}  // namespace
+}  // namespace chimera::bench
+
+int main(int argc, char** argv) {
+  using namespace chimera;
+  using namespace chimera::bench;
+  const Args args = Args::parse(argc, argv);
+  const std::string worker = worker_arg(args);
+  const int pairs = args.quick ? 2 : 4;
+  const std::int64_t run_ns = (args.quick ? 2'000 : 10'000) * kMs;
+  const int kills = args.quick ? 5 : 20;
+
+  Fragment out;
+  auto& d = out.details();
+  d["loop"] = "traj, pid, robot, monitor at 1 kHz (rm); PID alone in process 'control' against all in one";
+  d["runs_per_mode"] = pairs;
+  d["run_s"] = static_cast<double>(run_ns) / 1e9;
+  std::vector<std::int64_t> p50[2];
+  std::vector<std::int64_t> p99[2];
+  for (int r = 0; r < pairs; ++r) {
+    for (const bool apart : {false, true}) {
+      auto run = run_loop(apart, worker, run_ns);
+      const char* mode = apart ? "pid_in_own_process" : "all_in_one";
+      if (!run) {
+        std::fprintf(stderr, "process_bench: %s: %s\n", mode, run.error().message.c_str());
+        d["error"] = std::string(mode) + ": " + run.error().message;
+        (void)out.write(args);
+        return 1;
+      }
+      p50[apart ? 1 : 0].push_back(run->latency_p50_ns);
+      p99[apart ? 1 : 0].push_back(run->latency_p99_ns);
+      d["runs"][mode].push_back({{"latency_p50_ns", run->latency_p50_ns},
+                                 {"latency_p99_ns", run->latency_p99_ns},
+                                 {"cycles", run->cycles},
+                                 {"missed", run->missed},
+                                 {"tasks", run->tasks}});
+    }
+  }
+  const auto median = [](std::vector<std::int64_t> v) {
+    std::sort(v.begin(), v.end());
+    return static_cast<double>(v[v.size() / 2]);
+  };
+  d["latency_p50_ns_median"] = {{"all_in_one", median(p50[0])}, {"pid_in_own_process", median(p50[1])}};
+  d["latency_p99_ns_median"] = {{"all_in_one", median(p99[0])}, {"pid_in_own_process", median(p99[1])}};
+  if (median(p50[0]) > 0) out.result("process_fig4_latency_p50_ratio", median(p50[1]) / median(p50[0]));
+  if (median(p99[0]) > 0) out.result("process_fig4_latency_p99_ratio", median(p99[1]) / median(p99[0]));
+
+  Recovery rec = kill_and_clear(worker, kills);
+  d["kills"] = kills;
+  d["kills_done"] = rec.death_to_error_ns.size();
+  if (!rec.error.empty()) {
+    std::fprintf(stderr, "process_bench: recovery: %s\n", rec.error.c_str());
+    d["error"] = "recovery: " + rec.error;
+    (void)out.write(args);
+    return 1;
+  }
+  std::sort(rec.death_to_error_ns.begin(), rec.death_to_error_ns.end());
+  std::sort(rec.clear_to_on_ns.begin(), rec.clear_to_on_ns.end());
+  d["death_to_error_ns"] = rec.death_to_error_ns;
+  d["clear_to_on_ns"] = rec.clear_to_on_ns;
+  out.result("process_death_to_error_ns_p50", percentile_sorted(rec.death_to_error_ns, 0.5));
+  out.result("process_death_to_error_ns_max", static_cast<double>(rec.death_to_error_ns.back()));
+  out.result("process_clear_to_on_ns_p50", percentile_sorted(rec.clear_to_on_ns, 0.5));
+  out.result("process_clear_to_on_ns_max", static_cast<double>(rec.clear_to_on_ns.back()));
+  std::remove(fmt::format("/tmp/process_bench_{}.yaml", ::getpid()).c_str());
+  return out.write(args);
+}

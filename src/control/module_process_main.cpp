@@ -1,0 +1,152 @@
+#include "chimera/control/module_process_main.hpp"
+
+#include <pthread.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdlib>
+#include <memory>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "chimera/config/verify.hpp"
+#include "chimera/svt/global_table.hpp"
+#include "exec/event_log.hpp"
+#include "exec/executive.hpp"
+#include "exec/process_protocol.hpp"
+#include "exec/task_block.hpp"
+#include "exec/task_set.hpp"
+
+namespace chimera {
+
+namespace {
+
+void reply(int socket_fd, const Result<void>& r) {
+  const ProcessReply message = ProcessReply::from(r);
+  (void)::send(socket_fd, &message, sizeof message, MSG_NOSIGNAL);
+}
+
+std::vector<std::size_t> indices(const std::array<std::uint32_t, ProcessCommand::kMaxTasks>& list, std::uint32_t n) {
+  const std::size_t count = std::min<std::size_t>(n, ProcessCommand::kMaxTasks);
+  return {list.begin(), list.begin() + static_cast<std::ptrdiff_t>(count)};
+}
+
+Result<void> commit(Executive& executive, const ProcessCommand& c, const std::vector<bool>& mine,
+                    const ResolvedSubsystem& resolved) {
+  SwitchCommit part;
+  part.leaving = indices(c.tasks, c.count);
+  part.joining = indices(c.joining, c.joining_count);
+  for (const std::size_t i : indices(c.target, c.target_count)) {
+    if (i >= resolved.tasks.size()) return make_error(Errc::kInvalidInput, fmt::format("no task {}", i));
+    part.target.push_back(resolved.tasks[i].spec->name);
+  }
+  for (const auto* list : {&part.leaving, &part.joining})
+    for (const std::size_t i : *list)
+      if (i >= mine.size() || !mine[i]) return make_error(Errc::kInvalidInput, fmt::format("task {} is not mine", i));
+  part.at_ns = c.at_ns;
+  part.part = static_cast<SwitchCommit::Part>(c.part);
+  return executive.commit_switch(part);
+}
+
+Result<void> carry_out(Executive& executive, const ProcessCommand& c, const std::vector<bool>& mine,
+                       const ResolvedSubsystem& resolved) {
+  if (c.kind == ProcessCommandKind::kCommit) return commit(executive, c, mine, resolved);
+  const std::vector<std::size_t> tasks = indices(c.tasks, c.count);
+  for (const std::size_t i : tasks)
+    if (i >= mine.size() || !mine[i]) return make_error(Errc::kInvalidInput, fmt::format("task {} is not mine", i));
+  if (tasks.empty() && c.kind != ProcessCommandKind::kQuit) return make_error(Errc::kInvalidInput, "no task");
+  switch (c.kind) {
+    case ProcessCommandKind::kSignal: return executive.signal(tasks.front(), c.signal);
+    case ProcessCommandKind::kTurnOnTogether: return executive.turn_on_together(tasks);
+    case ProcessCommandKind::kReinit: return executive.reinit(tasks.front());
+    case ProcessCommandKind::kQuit:
+    case ProcessCommandKind::kCommit: break;
+  }
+  return {};
+}
+
+}  // namespace
+
+int run_module_process(const SubsystemSpec& spec, const Registry& registry, const ModuleProcessArgs& args) {
+  const int sock = args.socket_fd;
+  const Resolution resolution = resolve_subsystem(spec, registry);
+  const ResolvedSubsystem& resolved = resolution.subsystem;
+  auto table = GlobalTable::attach(args.table);
+  if (!table) {
+    reply(sock, table.error());
+    return 1;
+  }
+  auto block = TaskBlock::attach(args.block_fd, resolved.tasks.size());
+  if (!block) {
+    reply(sock, block.error());
+    return 1;
+  }
+  // Its own tasks keep what the main process must see in the block; the others are never spawned here.
+  std::vector<TaskShared*> shared(resolved.tasks.size(), nullptr);
+  std::vector<bool> mine(resolved.tasks.size(), false);
+  for (std::size_t i = 0; i < resolved.tasks.size(); ++i) {
+    if (resolved.tasks[i].spec->process != args.process) continue;
+    shared[i] = block->slot(i);
+    mine[i] = true;
+  }
+  if (std::find(mine.begin(), mine.end(), true) == mine.end()) {
+    reply(sock, make_error(Errc::kInvalidInput, fmt::format("the file has no task in process {}", args.process)));
+    return 1;
+  }
+  TaskSet tasks(resolved, *table, nullptr, shared);
+  for (Task* t : tasks.pointers()) t->set_rt_check(args.rt_check);
+  EventLog events(tasks.size());  // the executive's own events; the tasks' are in the block, for the main process
+  const ConfigurationSpec* start = spec.find_configuration(args.configuration.value_or(spec.start));
+  ExecutiveSetup setup;
+  setup.clock = ClockKind::kReal;
+  setup.realtime_priorities = args.realtime_priorities;
+  setup.measure_cpu_time = args.measure_cpu_time;
+  setup.subsystem = &resolved;
+  setup.table = &*table;
+  setup.tasks = tasks.pointers();
+  if (start != nullptr) setup.configuration = start->tasks;
+  setup.events = &events;
+  setup.hosted = mine;
+  setup.epoch_ns = block->epoch_ns();
+  std::unique_ptr<Executive> executive = make_executive(std::move(setup));
+  // Held until this process ends, however it ends: the kernel hands it to the main process's
+  // watcher as this thread exits, long before the pidfd says the process is gone.
+  // The thread that holds the life lock runs at the lowest real-time priority: it only waits on
+  // its socket, and when the process is killed it is scheduled to exit (and so to free the
+  // lock) ahead of every ordinary thread of the machine.
+  if (args.realtime_priorities) {
+    sched_param lowest{};
+    lowest.sched_priority = 1;
+    (void)pthread_setschedparam(pthread_self(), SCHED_FIFO, &lowest);
+  }
+  pthread_mutex_t* life = nullptr;
+  if (args.life >= 0 && static_cast<std::size_t>(args.life) < ProcessCommand::kMaxTasks) {
+    life = block->life(static_cast<std::size_t>(args.life));
+    if (pthread_mutex_lock(life) == EOWNERDEAD) pthread_mutex_consistent(life);  // a previous start's
+  }
+  reply(sock, Result<void>{});  // ready
+
+  for (;;) {
+    ProcessCommand c;
+    const ssize_t got = ::recv(sock, &c, sizeof c, 0);
+    if (got == 0 || (got < 0 && errno != EINTR)) {
+      // The main process is gone (EOF): nobody will read the tasks' figures or send them off.
+      // End at once, so that a crashed main process never leaves a worker running on.
+      std::_Exit(0);
+    }
+    if (got != static_cast<ssize_t>(sizeof c)) continue;
+    if (c.kind == ProcessCommandKind::kQuit) {
+      executive->shutdown();
+      // Given back by hand: the block is unmapped on the way out, and the kernel can release a
+      // robust lock only where it is still mapped.
+      if (life != nullptr) pthread_mutex_unlock(life);
+      reply(sock, Result<void>{});
+      return 0;
+    }
+    reply(sock, carry_out(*executive, c, mine, resolved));
+  }
+}
+
+}  // namespace chimera

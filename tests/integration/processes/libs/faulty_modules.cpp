@@ -1,0 +1,97 @@
+// Modules that end or hang their process the ways a faulty module does (issue 15): a write through
+// a null pointer, abort(), exit(3), and an endless loop in cycle(). Each publishes a counter (so it is a writer of the table like any other)
+// and ends its process at cycle `after`; with `once_file` set, only while that file does not exist
+// (it creates it first), so that a restarted process runs on.
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <csignal>
+#include <cstdlib>
+#include <string>
+
+#include <chimera/module/registry.hpp>
+
+namespace {
+
+enum class Fault { kSegfault, kAbort, kExit, kLoop };
+
+template <Fault kFault>
+class EndsItsProcess : public chimera::Module {
+ public:
+  static void declare(chimera::Declarations& d, const chimera::Params& /*params*/) {
+    d.out_var("faulty_count", chimera::Dim::fixed(1), "cycles run");
+    d.param("after", 20.0, "", "the cycle that ends the process");
+    d.param("once_file", std::string(), "", "end the process only while this file does not exist");
+  }
+
+ protected:
+  chimera::Status init(chimera::InitContext& ctx) override {
+    count_ = ctx.out<double>("faulty_count");
+    after_ = static_cast<long>(ctx.params().number("after", 20.0));
+    once_file_ = ctx.params().text("once_file", "");
+    return chimera::Status::ok();
+  }
+
+  chimera::Status cycle() override {
+    count_[0] = static_cast<double>(++cycles_);
+    if (cycles_ < after_) return chimera::Status::ok();
+    if (!once_file_.empty()) {
+      const int fd = ::open(once_file_.c_str(), O_CREAT | O_EXCL | O_WRONLY | O_CLOEXEC, 0600);
+      if (fd < 0) return chimera::Status::ok();  // ended its process once already
+      ::close(fd);
+    }
+    if constexpr (kFault == Fault::kAbort) {
+      std::abort();
+    } else if constexpr (kFault == Fault::kExit) {
+      std::exit(3);
+    } else if constexpr (kFault == Fault::kLoop) {
+      for (;;) ::usleep(1000);  // endless, yet it leaves the CPU to the others: a module stuck, not a CPU hog
+    } else {
+      volatile int* nowhere = nullptr;
+      *nowhere = 1;  // NOLINT(clang-analyzer-core.NullDereference): the fault under test
+    }
+    return chimera::Status::ok();
+  }
+
+ private:
+  chimera::Out<double> count_;
+  long after_ = 20;
+  long cycles_ = 0;
+  std::string once_file_;
+};
+
+class SegfaultInCycle final : public EndsItsProcess<Fault::kSegfault> {
+ public:
+  static constexpr const char* kName = "segfault_in_cycle";
+  static constexpr const char* kSummary = "writes through a null pointer in cycle() (a test of module processes)";
+  static constexpr const char* kDoc = "Ends its process with SIGSEGV at cycle `after`.";
+};
+
+class AbortInCycle final : public EndsItsProcess<Fault::kAbort> {
+ public:
+  static constexpr const char* kName = "abort_in_cycle";
+  static constexpr const char* kSummary = "calls abort() in cycle() (a test of module processes)";
+  static constexpr const char* kDoc = "Ends its process with SIGABRT at cycle `after`.";
+};
+
+class ExitInCycle final : public EndsItsProcess<Fault::kExit> {
+ public:
+  static constexpr const char* kName = "exit_in_cycle";
+  static constexpr const char* kSummary = "calls exit(3) in cycle() (a test of module processes)";
+  static constexpr const char* kDoc = "Ends its process with exit code 3 at cycle `after`.";
+};
+
+class LoopInCycle final : public EndsItsProcess<Fault::kLoop> {
+ public:
+  static constexpr const char* kName = "loop_in_cycle";
+  static constexpr const char* kSummary = "never returns from cycle() (a test of module processes)";
+  static constexpr const char* kDoc = "Stays in cycle() forever from cycle `after` on.";
+};
+
+}  // namespace
+
+CHIMERA_REGISTER_MODULE(SegfaultInCycle);
+CHIMERA_REGISTER_MODULE(AbortInCycle);
+CHIMERA_REGISTER_MODULE(ExitInCycle);
+CHIMERA_REGISTER_MODULE(LoopInCycle);

@@ -1,0 +1,191 @@
+// Module processes (issue 15, docs/processes.md): Figure 4's loop in the main process beside a
+// module that writes through a null pointer, one that calls abort(), one that calls exit(3) and
+// one that never returns from cycle(), each in a process of its own. The loop keeps cycling, the
+// faulty tasks are ERROR with what ended their process (the stuck one's killed by the supervisor
+// for its heartbeat), the illegal-configuration flag is up, and clear + on brings them back in a
+// new process.
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "chimera/config/loader.hpp"
+#include "chimera/config/plugins.hpp"
+#include "chimera/control/subsystem.hpp"
+#include "chimera/module/registry.hpp"
+#include "run_chimera.hpp"
+
+namespace chimera {
+namespace {
+
+using test::TempDir;
+
+// Long enough for a loaded machine to start the workers and reach the faults; the tests wait for
+// what must happen, never for an amount of time to pass.
+constexpr std::int64_t kStepNs = 20'000'000;
+constexpr int kMaxSteps = 1500;
+
+std::string file_text(const TempDir& dir) {
+  return "subsystem: fig4_processes\n"
+         "plugins: [" FAULTY_PLUGIN "]\n"
+         "scheduler: rm\n"
+         "tasks:\n"
+         "  - {name: traj, module: joint_traj_gen, period: 1ms, criticality: soft}\n"
+         "  - {name: pid, module: pid_joint, period: 1ms, criticality: soft}\n"
+         "  - {name: robot, module: robot_torque, period: 1ms, criticality: soft}\n"
+         "  - name: segv\n"
+         "    module: segfault_in_cycle\n"
+         "    period: 2ms\n"
+         "    criticality: soft\n"
+         "    process: faulty\n"
+         "    params: {after: 25, once_file: " + dir.file("segv.once") + "}\n"
+         "  - name: aborts\n"
+         "    module: abort_in_cycle\n"
+         "    period: 2ms\n"
+         "    criticality: soft\n"
+         "    process: aborting\n"
+         "    rename: {faulty_count: abort_count}\n"
+         "    params: {after: 25, once_file: " + dir.file("abort.once") + "}\n"
+         "  - name: exits\n"
+         "    module: exit_in_cycle\n"
+         "    period: 2ms\n"
+         "    criticality: soft\n"
+         "    process: exiting\n"
+         "    rename: {faulty_count: exit_count}\n"
+         "    params: {after: 25, once_file: " + dir.file("exit.once") + "}\n"
+         "  - name: spin\n"
+         "    module: loop_in_cycle\n"
+         "    period: 2ms\n"
+         "    criticality: soft\n"
+         "    process: spinning\n"
+         "    rename: {faulty_count: spin_count}\n"
+         "    params: {after: 25, once_file: " + dir.file("spin.once") + "}\n";
+}
+
+constexpr const char* kFaulty[] = {"segv", "aborts", "exits", "spin"};
+
+const TaskSnapshot& task_of(const std::vector<TaskSnapshot>& all, const std::string& name) {
+  const auto it = std::find_if(all.begin(), all.end(), [&](const TaskSnapshot& t) { return t.name == name; });
+  EXPECT_NE(it, all.end()) << name;
+  return *it;
+}
+
+// Runs until `done` holds for the snapshot, or gives up after kMaxSteps.
+template <class Done>
+bool run_until(Subsystem& s, Done done) {
+  for (int i = 0; i < kMaxSteps; ++i) {
+    if (done(s.snapshot())) return true;
+    s.run_for(kStepNs);
+  }
+  return false;
+}
+
+class ModuleProcessTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    // A sanitizer's own SIGSEGV handler would report and exit with its code: in a sanitized
+    // build the workers still die of the signal, as in a plain one. Read by the workers only
+    // (this process read its options at start).
+    for (const char* var : {"ASAN_OPTIONS", "TSAN_OPTIONS"}) {
+      const char* now = std::getenv(var);  // NOLINT(concurrency-mt-unsafe): before any worker or thread
+      const std::string value = (now != nullptr && *now != '\0' ? std::string(now) + ":" : std::string()) + "handle_segv=0";
+      ::setenv(var, value.c_str(), 1);  // NOLINT(concurrency-mt-unsafe): as above
+    }
+    const std::string path = dir_.file("fig4_processes.yaml");
+    test::write_text(path, file_text(dir_));
+    auto plugins = load_file_plugins(path);
+    ASSERT_TRUE(plugins.ok()) << plugins.error().message;
+    auto spec = load_subsystem_file(path, Registry::global());
+    ASSERT_TRUE(spec.ok()) << spec.error().message;
+    RunOptions options;
+    options.realtime_priorities = false;  // the test runs anywhere; priorities are not its subject
+    options.shm_suffix = "_" + std::to_string(::getpid());
+    options.worker_program = CHIMERA_BIN;
+    auto made = Subsystem::create(*spec, Registry::global(), options);
+    ASSERT_TRUE(made.ok()) << made.error().message;
+    subsystem_ = std::move(*made);
+    ASSERT_TRUE(subsystem_->start().ok());
+  }
+
+  TempDir dir_;
+  std::unique_ptr<Subsystem> subsystem_;
+};
+
+TEST_F(ModuleProcessTest, CrashesStopOnlyTheirTasksAndClearBringsThemBack) {
+  Subsystem& s = *subsystem_;
+  const auto all_in_error = [](const std::vector<TaskSnapshot>& all) {
+    for (const char* name : kFaulty)
+      if (task_of(all, name).state != TaskState::kError) return false;
+    return true;
+  };
+  ASSERT_TRUE(run_until(s, all_in_error));
+  const auto at_faults = s.snapshot();
+  const auto says = [&](const char* task, const std::string& reason) {
+    EXPECT_NE(task_of(at_faults, task).last_error.find(reason), std::string::npos)
+        << task << ": " << task_of(at_faults, task).last_error;
+  };
+  says("segv", "its process faulty died (killed by SIGSEGV");
+  says("aborts", "its process aborting died (killed by SIGABRT");
+  says("exits", "its process exiting died (exited with code 3)");
+  says("spin", "its process spinning died (killed by the supervisor: spin stuck in cycle() for ");
+  EXPECT_TRUE(s.illegal_configuration());
+  // The faulty tasks ran in other processes: their cycles were counted where the main process reads them.
+  for (const char* name : kFaulty) EXPECT_GE(task_of(at_faults, name).stats.cycles, 24U) << name;
+
+  // Figure 4's loop keeps cycling, ON, after both deaths.
+  const auto grew = [&](const std::vector<TaskSnapshot>& now) {
+    for (const char* name : {"traj", "pid", "robot"})
+      if (task_of(now, name).stats.cycles <= task_of(at_faults, name).stats.cycles + 50) return false;
+    return true;
+  };
+  ASSERT_TRUE(run_until(s, grew));
+  for (const auto& t : s.snapshot()) {
+    if (t.name == "traj" || t.name == "pid" || t.name == "robot") {
+      EXPECT_EQ(t.state, TaskState::kOn) << t.name;
+    }
+  }
+
+  // clear starts each process again: its task is OFF, then on as usual, and cycles in the new process.
+  for (const char* name : kFaulty) {
+    auto cleared = s.signal(name, Signal::kClear);
+    ASSERT_TRUE(cleared.ok()) << cleared.error().message;
+    EXPECT_EQ(task_of(s.snapshot(), name).state, TaskState::kOff);
+    auto on = s.signal(name, Signal::kOn);
+    ASSERT_TRUE(on.ok()) << on.error().message;
+  }
+  EXPECT_FALSE(s.illegal_configuration()) << "every hold given back with the last clear";
+  const auto before = s.snapshot();
+  const auto back = [&](const std::vector<TaskSnapshot>& now) {
+    for (const char* name : kFaulty)
+      if (task_of(now, name).state != TaskState::kOn ||
+          task_of(now, name).stats.cycles <= task_of(before, name).stats.cycles + 30)
+        return false;
+    return true;
+  };
+  EXPECT_TRUE(run_until(s, back));
+  auto value = s.get("faulty_count");
+  ASSERT_TRUE(value.ok()) << value.error().message;
+  EXPECT_GT((*value)[0], 25.0);  // the new process's cycles, past the one that crashed the first
+  s.stop();
+  EXPECT_EQ(task_of(s.snapshot(), "segv").state, TaskState::kNotCreated);
+}
+
+TEST_F(ModuleProcessTest, TasksOfADeadProcessAreKilledByStop) {
+  Subsystem& s = *subsystem_;
+  ASSERT_TRUE(run_until(s, [](const auto& all) { return task_of(all, "segv").state == TaskState::kError; }));
+  // on is refused, saying why and what to do.
+  auto on = s.signal("segv", Signal::kOn);
+  ASSERT_FALSE(on.ok());
+  s.stop();
+  for (const auto& t : s.snapshot()) EXPECT_EQ(t.state, TaskState::kNotCreated) << t.name;
+}
+
+}  // namespace
+}  // namespace chimera
