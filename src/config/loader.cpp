@@ -4,15 +4,11 @@
 #include "chimera/config/loader.hpp"
 
 #include <algorithm>
-#include <cerrno>
-#include <filesystem>
-#include <fstream>
-#include <sstream>
-#include <system_error>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "detail/file_text.hpp"
 #include "detail/request_loader.hpp"
 #include "detail/task_loader.hpp"
 #include "detail/yaml_reader.hpp"
@@ -216,25 +212,14 @@ Result<SubsystemSpec> load(const Source& source, std::string_view text, const Re
   return spec;
 }
 
-Result<std::string> read_file(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec))
-    return make_error(Errc::kInvalidInput, fmt::format("{}: is a directory, not a subsystem file", path));
-  std::ifstream in(path, std::ios::binary);
-  if (!in)
-    return make_error(Errc::kInvalidInput,
-                      fmt::format("{}: cannot open the file ({})", path, std::generic_category().message(errno)));
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) return make_error(Errc::kInvalidInput, fmt::format("{}: cannot read the file", path));
-  return text.str();
-}
-
 }  // namespace
 
 Result<SubsystemSpec> load_subsystem_text(std::string_view text, const std::string& file_name,
                                           const Registry& registry) {
   const Source source(file_name);
+  if (text.size() > kMaxSubsystemFileBytes)
+    return source.fail(1, "", fmt::format("larger than {} bytes, the most a subsystem file may hold",
+                                          kMaxSubsystemFileBytes));
   // yaml-cpp reports with exceptions and a module's declare() might throw: neither may escape as
   // a crash, since a bad file must end in a message.
   try {
@@ -247,7 +232,7 @@ Result<SubsystemSpec> load_subsystem_text(std::string_view text, const std::stri
 }
 
 Result<SubsystemSpec> load_subsystem_file(const std::string& path, const Registry& registry) {
-  auto text = read_file(path);
+  auto text = config_detail::read_file_text(path);
   if (!text) return text.error();
   return load_subsystem_text(*text, path, registry);
 }
@@ -266,7 +251,7 @@ Result<std::vector<PluginRef>> read_plugin_names_text(std::string_view text, con
 }
 
 Result<std::vector<PluginRef>> read_plugin_names_file(const std::string& path) {
-  auto text = read_file(path);
+  auto text = config_detail::read_file_text(path);
   if (!text) return text.error();
   return read_plugin_names_text(*text, path);
 }
