@@ -9,6 +9,7 @@
 #include <fmt/ranges.h>
 
 #include "detail/file_text.hpp"
+#include "detail/name_index.hpp"
 #include "detail/request_loader.hpp"
 #include "detail/task_loader.hpp"
 #include "detail/yaml_reader.hpp"
@@ -19,7 +20,9 @@ namespace {
 using config_detail::element;
 using config_detail::entries;
 using config_detail::Field;
+using config_detail::FileNames;
 using config_detail::MapReader;
+using config_detail::NameIndex;
 using config_detail::Source;
 
 Result<void> read_name(const Source& source, const MapReader& top, SubsystemSpec& spec) {
@@ -99,15 +102,17 @@ Result<void> read_constants(const Source& source, const MapReader& top, Subsyste
   return {};
 }
 
-Result<void> read_tasks(const Source& source, const MapReader& top, const Registry& registry, SubsystemSpec& spec) {
+Result<void> read_tasks(const Source& source, const MapReader& top, const Registry& registry, SubsystemSpec& spec,
+                        NameIndex& task_names) {
   auto f = top.require(source, "tasks", "a subsystem needs at least one task");
   if (!f) return f.error();
   if (!f->node.IsSequence() || f->node.size() == 0)
     return source.fail(
         *f, fmt::format("must be a non-empty list of tasks (- name: ...), not {}", config_detail::describe(f->node)));
   for (std::size_t i = 0; i < f->node.size(); ++i) {
-    auto task = config_detail::load_task(source, element(*f, i, f->node[i]), spec, registry);
+    auto task = config_detail::load_task(source, element(*f, i, f->node[i]), spec, task_names, registry);
     if (!task) return task.error();
+    (void)task_names.insert(task->name, task->loc.line);
     spec.tasks.push_back(*std::move(task));
   }
   return {};
@@ -119,11 +124,13 @@ std::vector<std::string> task_names(const SubsystemSpec& spec) {
   return names;
 }
 
-Result<void> read_configurations(const Source& source, const MapReader& top, SubsystemSpec& spec) {
+Result<void> read_configurations(const Source& source, const MapReader& top, SubsystemSpec& spec,
+                                 FileNames& names) {
   const auto f = top.get("configurations");
   if (!f) {
     // No configurations written: the whole file is the one configuration.
     spec.configurations.push_back(ConfigurationSpec{"default", task_names(spec), SourceLoc{source.file(), 0}});
+    (void)names.configurations.insert("default", 0);
     return {};
   }
   if (auto ok = config_detail::check_free_keys(source, *f, "configurations"); !ok) return ok.error();
@@ -136,22 +143,24 @@ Result<void> read_configurations(const Source& source, const MapReader& top, Sub
       return source.fail(value, fmt::format("must be a list of task names, e.g. [traj, pid, robot], not {}",
                                             config_detail::describe(value.node)));
     ConfigurationSpec config{name, {}, SourceLoc{source.file(), value.line}};
+    NameIndex listed;
     for (std::size_t i = 0; i < value.node.size(); ++i) {
       const Field e = element(value, i, value.node[i]);
       auto task = config_detail::read_text(source, e);
       if (!task) return task.error();
-      if (spec.find_task(*task) == nullptr)
+      if (!names.tasks.contains(*task))
         return source.fail(e, fmt::format("no task named {} (tasks: {})", *task, fmt::join(task_names(spec), ", ")));
-      if (std::find(config.tasks.begin(), config.tasks.end(), *task) != config.tasks.end())
+      if (listed.insert(*task, e.line))
         return source.fail(e, fmt::format("task {} is listed twice", *task));
       config.tasks.push_back(*std::move(task));
     }
+    (void)names.configurations.insert(name, value.line);
     spec.configurations.push_back(std::move(config));
   }
   return {};
 }
 
-Result<void> read_start(const Source& source, const MapReader& top, SubsystemSpec& spec) {
+Result<void> read_start(const Source& source, const MapReader& top, SubsystemSpec& spec, const FileNames& names) {
   const auto f = top.get("start");
   if (!f) {
     spec.start = spec.configurations.front().name;
@@ -159,11 +168,11 @@ Result<void> read_start(const Source& source, const MapReader& top, SubsystemSpe
   }
   auto name = config_detail::read_text(source, *f);
   if (!name) return name.error();
-  if (spec.find_configuration(*name) == nullptr) {
-    std::vector<std::string> names;
-    for (const auto& c : spec.configurations) names.push_back(c.name);
-    return source.fail(*f,
-                       fmt::format("no configuration named {} (configurations: {})", *name, fmt::join(names, ", ")));
+  if (!names.configurations.contains(*name)) {
+    std::vector<std::string> configurations;
+    for (const auto& c : spec.configurations) configurations.push_back(c.name);
+    return source.fail(*f, fmt::format("no configuration named {} (configurations: {})", *name,
+                                       fmt::join(configurations, ", ")));
   }
   spec.start = *std::move(name);
   return {};
@@ -205,10 +214,11 @@ Result<SubsystemSpec> load(const Source& source, std::string_view text, const Re
   if (auto ok = read_plugins(source, *top, plugins); !ok) return ok.error();
   for (auto& p : plugins) spec.plugins.push_back(std::move(p.name));
   if (auto ok = read_constants(source, *top, spec); !ok) return ok.error();
-  if (auto ok = read_tasks(source, *top, registry, spec); !ok) return ok.error();
-  if (auto ok = read_configurations(source, *top, spec); !ok) return ok.error();
-  if (auto ok = read_start(source, *top, spec); !ok) return ok.error();
-  if (auto ok = config_detail::read_requests(source, top->get("requests"), spec); !ok) return ok.error();
+  config_detail::FileNames names;
+  if (auto ok = read_tasks(source, *top, registry, spec, names.tasks); !ok) return ok.error();
+  if (auto ok = read_configurations(source, *top, spec, names); !ok) return ok.error();
+  if (auto ok = read_start(source, *top, spec, names); !ok) return ok.error();
+  if (auto ok = config_detail::read_requests(source, top->get("requests"), names, spec); !ok) return ok.error();
   return spec;
 }
 
