@@ -180,18 +180,14 @@ Result<void> read_start(const Source& source, const MapReader& top, SubsystemSpe
 
 // The one document of the file as a checked top-level mapping.
 Result<MapReader> read_document(const Source& source, std::string_view text) {
-  std::vector<YAML::Node> documents;
-  try {
-    documents = YAML::LoadAll(std::string(text));
-  } catch (const YAML::ParserException& e) {
-    return source.fail(e.mark.is_null() ? 1 : e.mark.line + 1, "", fmt::format("YAML syntax error: {}", e.msg));
-  }
-  if (documents.empty() || documents.front().IsNull())
+  auto document = config_detail::load_first_document(source, text);
+  if (!document) return document.error();
+  if (!document->node.IsDefined() || document->node.IsNull())
     return source.fail(1, "", "the file is empty (a subsystem file needs at least subsystem: and tasks:)");
-  if (documents.size() > 1)
-    return source.fail(documents[1].Mark().is_null() ? 1 : documents[1].Mark().line + 1, "",
+  if (document->second_line)
+    return source.fail(*document->second_line, "",
                        "the file holds more than one YAML document (---); write one subsystem per file");
-  const Field root{documents.front(), documents.front().Mark().line + 1, ""};
+  const Field root{document->node, document->node.Mark().line + 1, ""};
   if (!root.node.IsMap())
     return source.fail(root, fmt::format("the file must be a mapping of keys (subsystem:, tasks:, ...), not {}",
                                          config_detail::describe(root.node)));

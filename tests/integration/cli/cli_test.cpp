@@ -82,6 +82,17 @@ TEST_F(CliTest, VerifyBadFileNamesFileLineAndKey) {
   EXPECT_TRUE(contains(o.err, "no_such_file.yaml")) << o.err;
 }
 
+// Found by the fuzzer: yaml-cpp 0.7 loops for ever on a ',' outside brackets (jbeder/yaml-cpp#1040).
+TEST_F(CliTest, AStrayCommaIsASyntaxErrorWithExitTwo) {
+  const std::string file = dir_.file("comma.yaml");
+  write_text(file, "# a subsystem file\n,\n");
+  for (const std::string verb : {"verify ", "analyze "}) {
+    auto o = chimera(verb + quoted(file));
+    EXPECT_EXIT_CODE(o, 2);
+    EXPECT_TRUE(contains(o.err, file + ":2: YAML syntax error: the parser cannot go on from here")) << verb << o.err;
+  }
+}
+
 // Only regular files are read: a FIFO without a writer would block, /dev/zero never end.
 TEST_F(CliTest, WhatIsNotARegularFileIsRefusedUnreadWithExitTwo) {
   const std::string fifo = dir_.file("fifo.yaml");
