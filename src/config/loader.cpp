@@ -124,8 +124,7 @@ std::vector<std::string> task_names(const SubsystemSpec& spec) {
   return names;
 }
 
-Result<void> read_configurations(const Source& source, const MapReader& top, SubsystemSpec& spec,
-                                 FileNames& names) {
+Result<void> read_configurations(const Source& source, const MapReader& top, SubsystemSpec& spec, FileNames& names) {
   const auto f = top.get("configurations");
   if (!f) {
     // No configurations written: the whole file is the one configuration.
@@ -150,8 +149,7 @@ Result<void> read_configurations(const Source& source, const MapReader& top, Sub
       if (!task) return task.error();
       if (!names.tasks.contains(*task))
         return source.fail(e, fmt::format("no task named {} (tasks: {})", *task, fmt::join(task_names(spec), ", ")));
-      if (listed.insert(*task, e.line))
-        return source.fail(e, fmt::format("task {} is listed twice", *task));
+      if (listed.insert(*task, e.line)) return source.fail(e, fmt::format("task {} is listed twice", *task));
       config.tasks.push_back(*std::move(task));
     }
     (void)names.configurations.insert(name, value.line);
@@ -171,8 +169,8 @@ Result<void> read_start(const Source& source, const MapReader& top, SubsystemSpe
   if (!names.configurations.contains(*name)) {
     std::vector<std::string> configurations;
     for (const auto& c : spec.configurations) configurations.push_back(c.name);
-    return source.fail(*f, fmt::format("no configuration named {} (configurations: {})", *name,
-                                       fmt::join(configurations, ", ")));
+    return source.fail(
+        *f, fmt::format("no configuration named {} (configurations: {})", *name, fmt::join(configurations, ", ")));
   }
   spec.start = *std::move(name);
   return {};
@@ -224,8 +222,8 @@ Result<SubsystemSpec> load_subsystem_text(std::string_view text, const std::stri
                                           const Registry& registry) {
   const Source source(file_name);
   if (text.size() > kMaxSubsystemFileBytes)
-    return source.fail(1, "", fmt::format("larger than {} bytes, the most a subsystem file may hold",
-                                          kMaxSubsystemFileBytes));
+    return source.fail(1, "",
+                       fmt::format("larger than {} bytes, the most a subsystem file may hold", kMaxSubsystemFileBytes));
   // yaml-cpp reports with exceptions and a module's declare() might throw: neither may escape as
   // a crash, since a bad file must end in a message.
   try {

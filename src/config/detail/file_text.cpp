@@ -43,8 +43,8 @@ std::string_view kind_of(mode_t mode) {
 }
 
 Error too_large(const std::string& path) {
-  return Error{Errc::kInvalidInput,
-               fmt::format("{}: larger than {} bytes, the most a subsystem file may hold", path, kMaxSubsystemFileBytes)};
+  return Error{Errc::kInvalidInput, fmt::format("{}: larger than {} bytes, the most a subsystem file may hold", path,
+                                                kMaxSubsystemFileBytes)};
 }
 
 }  // namespace

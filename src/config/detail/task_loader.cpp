@@ -221,7 +221,7 @@ Result<void> read_rename(const Source& source, const Field& field, const ModuleI
 }  // namespace
 
 Result<TaskSpec> load_task(const Source& source, const Field& task_field, const SubsystemSpec& file,
-                           const NameIndex& earlier_tasks,                            const Registry& registry) {
+                           const NameIndex& earlier_tasks, const Registry& registry) {
   auto map = MapReader::create(source, task_field, "a task",
                                {"name", "module", "period", "frequency", "deadline", "criticality", "wcet", "cpu",
                                 "priority", "late", "virtual_exec", "server", "params", "rename"});

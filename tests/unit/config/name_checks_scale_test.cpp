@@ -32,8 +32,8 @@ GeneratedFile chain(int tasks) {
   for (int i = 0; i < tasks; ++i) f.text += "  unused" + n_of(i) + ": 1\n";
   f.text += "tasks:\n";
   for (int i = 0; i < tasks; ++i)
-    f.text += "  - {name: t" + n_of(i) + ", module: visual_servo, period: 1ms, rename: {x_m: v" + n_of(i) +
-              ", x_d: v" + n_of(i + 1) + "}}\n";
+    f.text += "  - {name: t" + n_of(i) + ", module: visual_servo, period: 1ms, rename: {x_m: v" + n_of(i) + ", x_d: v" +
+              n_of(i + 1) + "}}\n";
   f.text += "configurations:\n  whole:\n";
   for (int i = 0; i < tasks; ++i) f.text += "    - t" + n_of(i) + "\n";
   for (int i = 0; i < tasks; ++i) f.text += "  only" + n_of(i) + ": [t" + n_of(i) + "]\n";
