@@ -1,6 +1,6 @@
 # Chimera's front door. On a fresh Debian 12 machine:
 #   make demo    install what is missing, build, run the Figure 4 demo
-#   make test    install what is missing, build and test: plain, ASAN+UBSAN, TSAN trees
+#   make test    install what is missing, build and test: plain, ASAN+UBSAN, TSAN trees, a fuzz pass
 # `make help` lists the other targets. CI runs .ci/run (= make test) with CI=true, which
 # turns compiler warnings into errors.
 
@@ -14,9 +14,11 @@ JOBS ?= 2
 BUILD_DIR ?= build
 ASAN_DIR ?= build-asan
 TSAN_DIR ?= build-tsan
+FUZZ_DIR ?= build-fuzz
+FUZZ_SECONDS ?= 60
 BENCH_DIR ?= build-bench
 BUILD_TYPE ?= RelWithDebInfo
-export JOBS BUILD_DIR ASAN_DIR TSAN_DIR
+export JOBS BUILD_DIR ASAN_DIR TSAN_DIR FUZZ_DIR
 
 # The main job. It may change as the demo grows; everything else refers to this variable.
 DEMO_CMD ?= scripts/demo.sh $(BUILD_DIR) 5
@@ -25,13 +27,14 @@ DEMO_CMD ?= scripts/demo.sh $(BUILD_DIR) 5
 FORMAT_DIRS := include src modules sim apps tests bench
 TIDY_DIRS ?= src modules sim apps
 
-.PHONY: help setup setup-lint setup-bench build build-bench test check demo bench bench-quick format format-check tidy clean
+.PHONY: help setup setup-lint setup-bench build build-bench test check fuzz demo bench bench-quick format format-check tidy clean
 
 help:
 	@echo "make demo          install missing packages, build, run the demo (DEMO_CMD)"
-	@echo "make test          build and test $(BUILD_DIR)/, then ASAN+UBSAN ($(ASAN_DIR)/) and TSAN ($(TSAN_DIR)/)"
+	@echo "make test          build and test $(BUILD_DIR)/, then ASAN+UBSAN ($(ASAN_DIR)/), TSAN ($(TSAN_DIR)/), a short fuzz pass ($(FUZZ_DIR)/)"
 	@echo "make build         configure and build $(BUILD_DIR)/ ($(BUILD_TYPE), Ninja, ccache if present)"
 	@echo "make check         only the sanitizer trees of make test"
+	@echo "make fuzz          build the libFuzzer targets ($(FUZZ_DIR)/, clang), fuzz each FUZZ_SECONDS=$(FUZZ_SECONDS) s; fails on any finding"
 	@echo "make bench         Release build in $(BENCH_DIR)/, run every benchmark (~5 min), write bench/results/latest.{json,md}"
 	@echo "make bench-quick   the same, short (under a minute once built); report in $(BENCH_DIR)/bench-results/quick/"
 	@echo "make format        clang-format the sources in place; format-check only reports"
@@ -55,10 +58,15 @@ build: setup
 	@bash scripts/build.sh $(BUILD_DIR) -DCMAKE_BUILD_TYPE=$(BUILD_TYPE)
 
 test: setup
-	@bash scripts/test.sh main asan tsan
+	@bash scripts/test.sh main asan tsan fuzz
 
 check: setup
 	@bash scripts/test.sh asan tsan
+
+# Findings (crash-*, leak-*, timeout-*) land in $(FUZZ_DIR)/fuzz-work/NAME/; docs/fuzzing.md says
+# how one becomes a regression input.
+fuzz: setup
+	@FUZZ_SECONDS=$(FUZZ_SECONDS) bash scripts/test.sh fuzz
 
 demo: build
 	$(DEMO_CMD)
@@ -92,4 +100,4 @@ tidy: setup-lint
 	@bash scripts/tidy.sh $(BUILD_DIR) $(TIDY_DIRS)
 
 clean:
-	rm -rf $(BUILD_DIR) $(ASAN_DIR) $(TSAN_DIR) $(BENCH_DIR)
+	rm -rf $(BUILD_DIR) $(ASAN_DIR) $(TSAN_DIR) $(FUZZ_DIR) $(BENCH_DIR)

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Builds and tests the three trees `make test` runs, then prints one summary for all of them.
+# Builds and tests the trees `make test` runs, then prints one summary for all of them.
 #
-#   scripts/test.sh [main] [asan] [tsan]      (no argument: all three, in that order)
+#   scripts/test.sh [main] [asan] [tsan] [fuzz]     (no argument: all four, in that order)
 #
 #   main  build/       RelWithDebInfo; every test
 #   asan  build-asan/  AddressSanitizer + UndefinedBehaviorSanitizer; every test except those
@@ -9,10 +9,14 @@
 #   tsan  build-tsan/  ThreadSanitizer; the tests labelled concurrency, and only what they need, are
 #                      built and run, except those also labelled realtime (their timing cannot
 #                      hold in a build 5 to 15 times slower: a hard task misses its first deadline)
+#   fuzz  build-fuzz/  clang, libFuzzer + ASAN + UBSAN: only the fuzz targets of tests/fuzz are
+#                      built; each fuzzes for FUZZ_SECONDS (default here 15) from its seed corpus
+#                      and fails on any crash, leak or hang (`make fuzz`: 60 s each)
 #
 # A tree that fails does not stop the others; the exit status is non-zero if any tree failed.
 # Environment: JOBS (default 2), TEST_TIMEOUT (seconds per test, default 300; sanitizer trees
-# get three times that), BUILD_DIR / ASAN_DIR / TSAN_DIR to move the trees, CI=true for -Werror.
+# get three times that), BUILD_DIR / ASAN_DIR / TSAN_DIR / FUZZ_DIR to move the trees, CI=true
+# for -Werror.
 set -uo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
@@ -21,7 +25,7 @@ timeout="${TEST_TIMEOUT:-300}"
 san_timeout=$((timeout * 3))
 
 stages=("$@")
-((${#stages[@]})) || stages=(main asan tsan)
+((${#stages[@]})) || stages=(main asan tsan fuzz)
 
 # Sanitized trees: asserts on (Debug defines no NDEBUG) at -O1, which the sanitizer manuals
 # recommend for usable speed. Warnings stay on but are not errors there: GCC's instrumentation
@@ -113,8 +117,17 @@ for stage in "${stages[@]}"; do
         "TSAN_OPTIONS=${TSAN_OPTIONS:-halt_on_error=1:second_deadlock_stack=1}" "BUILD_TARGETS=tests_concurrency"
       extra_cmake=()
       ;;
+    fuzz)
+      # The fuzzers' own budget bounds each test; the ctest timeout only catches a stuck one.
+      extra_cmake=("${san_build[@]}")
+      run_stage fuzz "${FUZZ_DIR:-build-fuzz}" \
+        "-DCHIMERA_FUZZ=ON -DCMAKE_C_COMPILER=clang-14 -DCMAKE_CXX_COMPILER=clang++-14" \
+        "--timeout ${san_timeout} --no-tests=error -L fuzz" \
+        "FUZZ_SECONDS=${FUZZ_SECONDS:-15}" "BUILD_TARGETS=fuzz_targets"
+      extra_cmake=()
+      ;;
     *)
-      echo "test: unknown stage '${stage}' (main, asan, tsan)" >&2
+      echo "test: unknown stage '${stage}' (main, asan, tsan, fuzz)" >&2
       exit 2
       ;;
   esac

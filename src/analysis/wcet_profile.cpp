@@ -64,15 +64,11 @@ Result<ProfileEntry> read_entry(const Source& source, const Field& field, const 
 }
 
 Result<WcetProfile> read_profile(const Source& source, std::string_view text) {
-  std::vector<YAML::Node> documents;
-  try {
-    documents = YAML::LoadAll(std::string(text));
-  } catch (const YAML::ParserException& e) {
-    return source.fail(e.mark.is_null() ? 1 : e.mark.line + 1, "", fmt::format("YAML syntax error: {}", e.msg));
-  }
-  if (documents.size() != 1 || !documents.front().IsMap())
+  auto document = config_detail::load_first_document(source, text);
+  if (!document) return document.error();
+  if (document->second_line || !document->node.IsMap())
     return source.fail(1, "", "a profile is one mapping: subsystem:, clock: and tasks: (written by chimera profile)");
-  const Field root{documents.front(), documents.front().Mark().line + 1, ""};
+  const Field root{document->node, document->node.Mark().line + 1, ""};
   auto top = MapReader::create(source, root, "the profile", {"subsystem", "clock", "tasks"});
   if (!top) return top.error();
 

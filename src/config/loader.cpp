@@ -4,15 +4,12 @@
 #include "chimera/config/loader.hpp"
 
 #include <algorithm>
-#include <cerrno>
-#include <filesystem>
-#include <fstream>
-#include <sstream>
-#include <system_error>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "detail/file_text.hpp"
+#include "detail/name_index.hpp"
 #include "detail/request_loader.hpp"
 #include "detail/task_loader.hpp"
 #include "detail/yaml_reader.hpp"
@@ -23,7 +20,9 @@ namespace {
 using config_detail::element;
 using config_detail::entries;
 using config_detail::Field;
+using config_detail::FileNames;
 using config_detail::MapReader;
+using config_detail::NameIndex;
 using config_detail::Source;
 
 Result<void> read_name(const Source& source, const MapReader& top, SubsystemSpec& spec) {
@@ -113,15 +112,17 @@ Result<void> read_default_process(const Source& source, const MapReader& top, Su
   return {};
 }
 
-Result<void> read_tasks(const Source& source, const MapReader& top, const Registry& registry, SubsystemSpec& spec) {
+Result<void> read_tasks(const Source& source, const MapReader& top, const Registry& registry, SubsystemSpec& spec,
+                        NameIndex& task_names) {
   auto f = top.require(source, "tasks", "a subsystem needs at least one task");
   if (!f) return f.error();
   if (!f->node.IsSequence() || f->node.size() == 0)
     return source.fail(
         *f, fmt::format("must be a non-empty list of tasks (- name: ...), not {}", config_detail::describe(f->node)));
   for (std::size_t i = 0; i < f->node.size(); ++i) {
-    auto task = config_detail::load_task(source, element(*f, i, f->node[i]), spec, registry);
+    auto task = config_detail::load_task(source, element(*f, i, f->node[i]), spec, task_names, registry);
     if (!task) return task.error();
+    (void)task_names.insert(task->name, task->loc.line);
     spec.tasks.push_back(*std::move(task));
   }
   return {};
@@ -133,11 +134,12 @@ std::vector<std::string> task_names(const SubsystemSpec& spec) {
   return names;
 }
 
-Result<void> read_configurations(const Source& source, const MapReader& top, SubsystemSpec& spec) {
+Result<void> read_configurations(const Source& source, const MapReader& top, SubsystemSpec& spec, FileNames& names) {
   const auto f = top.get("configurations");
   if (!f) {
     // No configurations written: the whole file is the one configuration.
     spec.configurations.push_back(ConfigurationSpec{"default", task_names(spec), SourceLoc{source.file(), 0}});
+    (void)names.configurations.insert("default", 0);
     return {};
   }
   if (auto ok = config_detail::check_free_keys(source, *f, "configurations"); !ok) return ok.error();
@@ -150,22 +152,23 @@ Result<void> read_configurations(const Source& source, const MapReader& top, Sub
       return source.fail(value, fmt::format("must be a list of task names, e.g. [traj, pid, robot], not {}",
                                             config_detail::describe(value.node)));
     ConfigurationSpec config{name, {}, SourceLoc{source.file(), value.line}};
+    NameIndex listed;
     for (std::size_t i = 0; i < value.node.size(); ++i) {
       const Field e = element(value, i, value.node[i]);
       auto task = config_detail::read_text(source, e);
       if (!task) return task.error();
-      if (spec.find_task(*task) == nullptr)
+      if (!names.tasks.contains(*task))
         return source.fail(e, fmt::format("no task named {} (tasks: {})", *task, fmt::join(task_names(spec), ", ")));
-      if (std::find(config.tasks.begin(), config.tasks.end(), *task) != config.tasks.end())
-        return source.fail(e, fmt::format("task {} is listed twice", *task));
+      if (listed.insert(*task, e.line)) return source.fail(e, fmt::format("task {} is listed twice", *task));
       config.tasks.push_back(*std::move(task));
     }
+    (void)names.configurations.insert(name, value.line);
     spec.configurations.push_back(std::move(config));
   }
   return {};
 }
 
-Result<void> read_start(const Source& source, const MapReader& top, SubsystemSpec& spec) {
+Result<void> read_start(const Source& source, const MapReader& top, SubsystemSpec& spec, const FileNames& names) {
   const auto f = top.get("start");
   if (!f) {
     spec.start = spec.configurations.front().name;
@@ -173,11 +176,11 @@ Result<void> read_start(const Source& source, const MapReader& top, SubsystemSpe
   }
   auto name = config_detail::read_text(source, *f);
   if (!name) return name.error();
-  if (spec.find_configuration(*name) == nullptr) {
-    std::vector<std::string> names;
-    for (const auto& c : spec.configurations) names.push_back(c.name);
-    return source.fail(*f,
-                       fmt::format("no configuration named {} (configurations: {})", *name, fmt::join(names, ", ")));
+  if (!names.configurations.contains(*name)) {
+    std::vector<std::string> configurations;
+    for (const auto& c : spec.configurations) configurations.push_back(c.name);
+    return source.fail(
+        *f, fmt::format("no configuration named {} (configurations: {})", *name, fmt::join(configurations, ", ")));
   }
   spec.start = *std::move(name);
   return {};
@@ -185,18 +188,14 @@ Result<void> read_start(const Source& source, const MapReader& top, SubsystemSpe
 
 // The one document of the file as a checked top-level mapping.
 Result<MapReader> read_document(const Source& source, std::string_view text) {
-  std::vector<YAML::Node> documents;
-  try {
-    documents = YAML::LoadAll(std::string(text));
-  } catch (const YAML::ParserException& e) {
-    return source.fail(e.mark.is_null() ? 1 : e.mark.line + 1, "", fmt::format("YAML syntax error: {}", e.msg));
-  }
-  if (documents.empty() || documents.front().IsNull())
+  auto document = config_detail::load_first_document(source, text);
+  if (!document) return document.error();
+  if (!document->node.IsDefined() || document->node.IsNull())
     return source.fail(1, "", "the file is empty (a subsystem file needs at least subsystem: and tasks:)");
-  if (documents.size() > 1)
-    return source.fail(documents[1].Mark().is_null() ? 1 : documents[1].Mark().line + 1, "",
+  if (document->second_line)
+    return source.fail(*document->second_line, "",
                        "the file holds more than one YAML document (---); write one subsystem per file");
-  const Field root{documents.front(), documents.front().Mark().line + 1, ""};
+  const Field root{document->node, document->node.Mark().line + 1, ""};
   if (!root.node.IsMap())
     return source.fail(root, fmt::format("the file must be a mapping of keys (subsystem:, tasks:, ...), not {}",
                                          config_detail::describe(root.node)));
@@ -221,25 +220,12 @@ Result<SubsystemSpec> load(const Source& source, std::string_view text, const Re
   for (auto& p : plugins) spec.plugins.push_back(std::move(p.name));
   if (auto ok = read_constants(source, *top, spec); !ok) return ok.error();
   if (auto ok = read_default_process(source, *top, spec); !ok) return ok.error();
-  if (auto ok = read_tasks(source, *top, registry, spec); !ok) return ok.error();
-  if (auto ok = read_configurations(source, *top, spec); !ok) return ok.error();
-  if (auto ok = read_start(source, *top, spec); !ok) return ok.error();
-  if (auto ok = config_detail::read_requests(source, top->get("requests"), spec); !ok) return ok.error();
+  config_detail::FileNames names;
+  if (auto ok = read_tasks(source, *top, registry, spec, names.tasks); !ok) return ok.error();
+  if (auto ok = read_configurations(source, *top, spec, names); !ok) return ok.error();
+  if (auto ok = read_start(source, *top, spec, names); !ok) return ok.error();
+  if (auto ok = config_detail::read_requests(source, top->get("requests"), names, spec); !ok) return ok.error();
   return spec;
-}
-
-Result<std::string> read_file(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec))
-    return make_error(Errc::kInvalidInput, fmt::format("{}: is a directory, not a subsystem file", path));
-  std::ifstream in(path, std::ios::binary);
-  if (!in)
-    return make_error(Errc::kInvalidInput,
-                      fmt::format("{}: cannot open the file ({})", path, std::generic_category().message(errno)));
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) return make_error(Errc::kInvalidInput, fmt::format("{}: cannot read the file", path));
-  return text.str();
 }
 
 }  // namespace
@@ -247,6 +233,9 @@ Result<std::string> read_file(const std::string& path) {
 Result<SubsystemSpec> load_subsystem_text(std::string_view text, const std::string& file_name,
                                           const Registry& registry) {
   const Source source(file_name);
+  if (text.size() > kMaxSubsystemFileBytes)
+    return source.fail(1, "",
+                       fmt::format("larger than {} bytes, the most a subsystem file may hold", kMaxSubsystemFileBytes));
   // yaml-cpp reports with exceptions and a module's declare() might throw: neither may escape as
   // a crash, since a bad file must end in a message.
   try {
@@ -259,7 +248,7 @@ Result<SubsystemSpec> load_subsystem_text(std::string_view text, const std::stri
 }
 
 Result<SubsystemSpec> load_subsystem_file(const std::string& path, const Registry& registry) {
-  auto text = read_file(path);
+  auto text = config_detail::read_file_text(path);
   if (!text) return text.error();
   return load_subsystem_text(*text, path, registry);
 }
@@ -278,7 +267,7 @@ Result<std::vector<PluginRef>> read_plugin_names_text(std::string_view text, con
 }
 
 Result<std::vector<PluginRef>> read_plugin_names_file(const std::string& path) {
-  auto text = read_file(path);
+  auto text = config_detail::read_file_text(path);
   if (!text) return text.error();
   return read_plugin_names_text(*text, path);
 }

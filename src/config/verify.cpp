@@ -10,12 +10,14 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "detail/name_index.hpp"
 #include "detail/text.hpp"
 
 namespace chimera {
 namespace {
 
 using config_detail::join_names;
+using config_detail::NameIndex;
 using config_detail::shape_text;
 
 // One end of a variable: a task's port, or `constants:` (task == nullptr).
@@ -55,17 +57,50 @@ struct Ends {
   std::map<std::string, std::vector<End>> consumers;
 };
 
-Ends gather(const ResolvedSubsystem& subsystem, const std::vector<std::string>& task_names) {
-  Ends ends;
-  for (const auto& [name, value] : subsystem.spec->constants) {
-    const VarShape shape{ElemType::kF64, static_cast<std::uint32_t>(value.size())};
-    ends.producers[name].push_back(End{nullptr, nullptr, shape});
+// Where each task and each constant of the file is (its position), looked up once per name of a
+// configuration: the work of judging one is in proportion to its own tasks, not to the file's.
+struct FileIndex {
+  NameIndex tasks;
+  NameIndex constants;
+
+  explicit FileIndex(const ResolvedSubsystem& subsystem) {
+    for (std::size_t i = 0; i < subsystem.tasks.size(); ++i)
+      (void)tasks.insert(subsystem.tasks[i].spec->name, static_cast<int>(i));
+    for (std::size_t i = 0; i < subsystem.spec->constants.size(); ++i)
+      (void)constants.insert(subsystem.spec->constants[i].first, static_cast<int>(i));
   }
-  for (const auto& t : subsystem.tasks) {
-    if (std::find(task_names.begin(), task_names.end(), t.spec->name) == task_names.end()) continue;
+};
+
+Ends gather(const ResolvedSubsystem& subsystem, const FileIndex& index, const std::vector<std::string>& task_names) {
+  // In file order, each task once however often it is listed.
+  std::vector<int> positions;
+  positions.reserve(task_names.size());
+  for (const auto& name : task_names)
+    if (const auto at = index.tasks.find(name)) positions.push_back(*at);
+  std::sort(positions.begin(), positions.end());
+  positions.erase(std::unique(positions.begin(), positions.end()), positions.end());
+
+  Ends ends;
+  for (const int at : positions) {
+    const ResolvedTask& t = subsystem.tasks[static_cast<std::size_t>(at)];
     for (const auto& b : t.bindings)
       (is_input(b.kind) ? ends.consumers : ends.producers)[b.variable].push_back(End{&t, &b, b.shape});
   }
+  // `constants:` only where a task of the configuration uses the variable: a constant alone can
+  // break no rule. It goes first among the producers.
+  auto add_constant = [&](const std::string& variable) {
+    const auto at = index.constants.find(variable);
+    if (!at) return;
+    const auto& value = subsystem.spec->constants[static_cast<std::size_t>(*at)].second;
+    auto& producers = ends.producers[variable];
+    if (!producers.empty() && producers.front().task == nullptr) return;  // added already
+    const VarShape shape{ElemType::kF64, static_cast<std::uint32_t>(value.size())};
+    producers.insert(producers.begin(), End{nullptr, nullptr, shape});
+  };
+  std::vector<std::string> used;
+  for (const auto& [variable, ends_of] : ends.producers) used.push_back(variable);
+  for (const auto& [variable, ends_of] : ends.consumers) used.push_back(variable);
+  for (const auto& variable : used) add_constant(variable);
   return ends;
 }
 
@@ -130,27 +165,33 @@ void check_rule3(const Ends& ends, Report& report) {
   }
 }
 
-}  // namespace
-
-std::vector<Violation> verify_tasks(const ResolvedSubsystem& subsystem, const std::vector<std::string>& task_names,
-                                    const std::string& configuration_name) {
+std::vector<Violation> verify_indexed(const ResolvedSubsystem& subsystem, const FileIndex& index,
+                                      const std::vector<std::string>& task_names,
+                                      const std::string& configuration_name) {
   Report report(configuration_name);
   for (const auto& name : task_names)
-    if (subsystem.find_task(name) == nullptr)
-      report.add(0, {}, {name}, fmt::format("no task named {} in the file", name));
-  const Ends ends = gather(subsystem, task_names);
+    if (!index.tasks.contains(name)) report.add(0, {}, {name}, fmt::format("no task named {} in the file", name));
+  const Ends ends = gather(subsystem, index, task_names);
   check_rule1(ends, report);
   check_rule2(ends, report);
   check_rule3(ends, report);
   return report.take();
 }
 
+}  // namespace
+
+std::vector<Violation> verify_tasks(const ResolvedSubsystem& subsystem, const std::vector<std::string>& task_names,
+                                    const std::string& configuration_name) {
+  return verify_indexed(subsystem, FileIndex(subsystem), task_names, configuration_name);
+}
+
 std::vector<Violation> verify_subsystem(const Resolution& resolution, const std::optional<std::string>& only) {
   std::vector<Violation> out = resolution.violations;
   const SubsystemSpec& spec = *resolution.subsystem.spec;
+  const FileIndex index(resolution.subsystem);  // once for every configuration
   for (const auto& config : spec.configurations) {
     if (only && config.name != *only) continue;
-    auto found = verify_tasks(resolution.subsystem, config.tasks, config.name);
+    auto found = verify_indexed(resolution.subsystem, index, config.tasks, config.name);
     out.insert(out.end(), std::make_move_iterator(found.begin()), std::make_move_iterator(found.end()));
   }
   if (only && spec.find_configuration(*only) == nullptr) {

@@ -2,6 +2,7 @@
 // Loading a subsystem file. Every problem is reported as "file:line: key: problem", and a file
 // with any problem is refused whole.
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <string_view>
@@ -19,7 +20,13 @@ namespace chimera {
 Result<std::int64_t> parse_duration_ns(std::string_view text);
 Result<std::int64_t> parse_frequency_period_ns(std::string_view text);
 
-/// Loads and checks `path`: unknown keys, bad values, unknown modules or parameters, duplicate
+/// The largest subsystem file read (4 MiB: tens of thousands of tasks). A larger file, or text,
+/// is refused with a message before it is parsed, so that loading takes time and memory in
+/// proportion to what may be read.
+inline constexpr std::size_t kMaxSubsystemFileBytes = std::size_t{4} << 20;
+
+/// Loads and checks `path`, which must be a regular file (a directory, FIFO or device is refused
+/// unread) of at most kMaxSubsystemFileBytes: unknown keys, bad values, unknown modules or parameters, duplicate
 /// or unknown task names, empty files. Errors carry Errc::kInvalidInput. Not real-time safe.
 Result<SubsystemSpec> load_subsystem_file(const std::string& path, const Registry& registry);
 /// The same for text already in memory; `file_name` is used in messages.

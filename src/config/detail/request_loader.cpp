@@ -7,10 +7,11 @@ namespace chimera::config_detail {
 
 namespace {
 
-Result<std::string> read_configuration_name(const Source& source, const Field& field, const SubsystemSpec& spec) {
+Result<std::string> read_configuration_name(const Source& source, const Field& field, const FileNames& file_names,
+                                            const SubsystemSpec& spec) {
   auto name = read_text(source, field);
   if (!name) return name.error();
-  if (spec.find_configuration(*name) != nullptr) return name;
+  if (file_names.configurations.contains(*name)) return name;
   std::vector<std::string> names;
   for (const auto& c : spec.configurations) names.push_back(c.name);
   return source.fail(field,
@@ -19,7 +20,8 @@ Result<std::string> read_configuration_name(const Source& source, const Field& f
 
 }  // namespace
 
-Result<void> read_requests(const Source& source, const std::optional<Field>& field, SubsystemSpec& spec) {
+Result<void> read_requests(const Source& source, const std::optional<Field>& field, const FileNames& names,
+                           SubsystemSpec& spec) {
   if (!field || field->node.IsNull()) return {};
   if (!field->node.IsSequence())
     return source.fail(*field, fmt::format("must be a list of switches tasks may ask for, e.g. "
@@ -33,11 +35,11 @@ Result<void> read_requests(const Source& source, const std::optional<Field>& fie
     request.loc = SourceLoc{source.file(), entry.line};
     auto to = map->require(source, "to", "the configuration a task may ask for");
     if (!to) return to.error();
-    auto to_name = read_configuration_name(source, *to, spec);
+    auto to_name = read_configuration_name(source, *to, names, spec);
     if (!to_name) return to_name.error();
     request.to = *std::move(to_name);
     if (const auto from = map->get("from")) {
-      auto from_name = read_configuration_name(source, *from, spec);
+      auto from_name = read_configuration_name(source, *from, names, spec);
       if (!from_name) return from_name.error();
       if (*from_name == request.to)
         return source.fail(*from, "a switch from a configuration to itself changes nothing");
@@ -46,10 +48,10 @@ Result<void> read_requests(const Source& source, const std::optional<Field>& fie
     if (const auto by = map->get("by")) {
       auto task = read_text(source, *by);
       if (!task) return task.error();
-      if (spec.find_task(*task) == nullptr) {
-        std::vector<std::string> names;
-        for (const auto& t : spec.tasks) names.push_back(t.name);
-        return source.fail(*by, fmt::format("no task named {} (tasks: {})", *task, fmt::join(names, ", ")));
+      if (!names.tasks.contains(*task)) {
+        std::vector<std::string> task_names;
+        for (const auto& t : spec.tasks) task_names.push_back(t.name);
+        return source.fail(*by, fmt::format("no task named {} (tasks: {})", *task, fmt::join(task_names, ", ")));
       }
       request.by = *std::move(task);
     }

@@ -221,7 +221,7 @@ Result<void> read_rename(const Source& source, const Field& field, const ModuleI
 }  // namespace
 
 Result<TaskSpec> load_task(const Source& source, const Field& task_field, const SubsystemSpec& file,
-                           const Registry& registry) {
+                           const NameIndex& earlier_tasks, const Registry& registry) {
   auto map = MapReader::create(source, task_field, "a task",
                                {"name", "module", "period", "frequency", "deadline", "criticality", "wcet", "cpu",
                                 "priority", "late", "virtual_exec", "server", "params", "rename", "process"});
@@ -233,8 +233,8 @@ Result<TaskSpec> load_task(const Source& source, const Field& task_field, const 
   if (!name_field) return name_field.error();
   auto name = read_identifier(source, *name_field, "task name");
   if (!name) return name.error();
-  if (const TaskSpec* first = file.find_task(*name))
-    return source.fail(*name_field, fmt::format("task {} is already defined at line {}", *name, first->loc.line));
+  if (const auto first_line = earlier_tasks.find(*name))
+    return source.fail(*name_field, fmt::format("task {} is already defined at line {}", *name, *first_line));
   task.name = *std::move(name);
 
   auto module_field = map->require(source, "module", "the module type this task runs, e.g. pid_joint");

@@ -9,6 +9,7 @@
 #include <fmt/ranges.h>
 
 #include "chimera/config/loader.hpp"
+#include "detail/name_index.hpp"
 
 namespace chimera::config_detail {
 namespace {
@@ -88,15 +89,13 @@ Result<void> check_free_keys(const Source& source, const Field& field, std::stri
   if (field.node.IsNull()) return {};
   if (!field.node.IsMap())
     return source.fail(field, fmt::format("{} must be a mapping, not {}", what, describe(field.node)));
-  std::vector<std::pair<std::string, int>> seen;
+  NameIndex seen;  // these maps are the file's to size (constants, configurations): no scan per key
   for (const auto& kv : field.node) {
     const int key_line = line_of(kv.first, field.line);
     if (!kv.first.IsScalar()) return source.fail(key_line, field.path, "keys must be plain names");
     const std::string& key = kv.first.Scalar();
-    for (const auto& [name, line] : seen)
-      if (name == key)
-        return source.fail(key_line, join_path(field.path, key), fmt::format("written twice (first at line {})", line));
-    seen.emplace_back(key, key_line);
+    if (const auto line = seen.insert(key, key_line))
+      return source.fail(key_line, join_path(field.path, key), fmt::format("written twice (first at line {})", *line));
   }
   return {};
 }

@@ -91,4 +91,17 @@ Result<std::vector<double>> read_numbers(const Source& source, const Field& fiel
 /// text.
 Result<ParamValue> read_param_value(const Source& source, const Field& field);
 
+/// The first YAML document of a text, and where a second one starts (1-based line), if any.
+struct FirstDocument {
+  YAML::Node node;  // null if the text holds no document
+  std::optional<int> second_line;
+};
+
+/// The first document of `text` and whether another follows, in place of YAML::LoadAll, which in
+/// yaml-cpp 0.7 loops for ever, taking memory as it goes, on a ',' outside brackets
+/// (jbeder/yaml-cpp#1040, fixed upstream by #1319): the parser, stuck on a token it cannot use,
+/// starts empty documents there without end. That, and any syntax error, is
+/// "file:line: YAML syntax error: ...". Not real-time safe (yaml_documents.cpp).
+Result<FirstDocument> load_first_document(const Source& source, std::string_view text);
+
 }  // namespace chimera::config_detail

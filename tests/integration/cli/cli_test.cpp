@@ -1,10 +1,12 @@
 // The chimera command as users script it (contract section 2): exit codes, messages, runs.
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <filesystem>
 #include <regex>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -78,6 +80,31 @@ TEST_F(CliTest, VerifyBadFileNamesFileLineAndKey) {
   o = chimera("verify " + data("no_such_file.yaml"));
   EXPECT_EXIT_CODE(o, 2);
   EXPECT_TRUE(contains(o.err, "no_such_file.yaml")) << o.err;
+}
+
+// Found by the fuzzer: yaml-cpp 0.7 loops for ever on a ',' outside brackets (jbeder/yaml-cpp#1040).
+TEST_F(CliTest, AStrayCommaIsASyntaxErrorWithExitTwo) {
+  const std::string file = dir_.file("comma.yaml");
+  write_text(file, "# a subsystem file\n,\n");
+  for (const std::string verb : {"verify ", "analyze "}) {
+    auto o = chimera(verb + quoted(file));
+    EXPECT_EXIT_CODE(o, 2);
+    EXPECT_TRUE(contains(o.err, file + ":2: YAML syntax error: the parser cannot go on from here")) << verb << o.err;
+  }
+}
+
+// Only regular files are read: a FIFO without a writer would block, /dev/zero never end.
+TEST_F(CliTest, WhatIsNotARegularFileIsRefusedUnreadWithExitTwo) {
+  const std::string fifo = dir_.file("fifo.yaml");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  for (const auto& [file, kind] : std::vector<std::pair<std::string, std::string>>{
+           {fifo, "a FIFO"}, {"/dev/zero", "a character device"}, {dir_.path(), "a directory"}}) {
+    for (const std::string verb : {"verify ", "analyze ", "run "}) {
+      auto o = chimera(verb + quoted(file) + (verb == "run " ? " --clock virtual --for 10ms" : ""));
+      EXPECT_EXIT_CODE(o, 2);
+      EXPECT_TRUE(contains(o.err, file + ": is " + kind + ", not a subsystem file")) << verb << o.err;
+    }
+  }
 }
 
 TEST_F(CliTest, ModulesListsThePaperModules) {

@@ -38,6 +38,15 @@ TEST(LoaderErrors, YamlSyntaxError) {
   EXPECT_EQ(error_of("subsystem: s\n  bad: indent\n"), "pid.yaml:2: YAML syntax error: illegal map value");
 }
 
+// yaml-cpp 0.7's LoadAll never returns on these (jbeder/yaml-cpp#1040); the fuzzer found it
+// (tests/fuzz/regressions/subsystem_file/yaml_cpp_1040_*).
+TEST(LoaderErrors, AStrayCommaIsASyntaxErrorNotAHang) {
+  constexpr const char* kStuck = "YAML syntax error: the parser cannot go on from here (a ',' outside [ ] or { }?)";
+  EXPECT_EQ(error_of(","), std::string("pid.yaml:1: ") + kStuck);
+  EXPECT_EQ(error_of("[a], b\n"), std::string("pid.yaml:1: ") + kStuck);
+  EXPECT_EQ(error_of("# comment\n\n  ,\n"), std::string("pid.yaml:3: ") + kStuck);
+}
+
 TEST(LoaderErrors, MoreThanOneDocument) {
   EXPECT_EQ(error_of("subsystem: s\ntasks: []\n---\nsubsystem: t\n"),
             "pid.yaml:4: the file holds more than one YAML document (---); write one subsystem per file");

@@ -305,7 +305,7 @@ TEST(LoadSubsystemFile, MissingFileSaysSo) {
 TEST(LoadSubsystemFile, DirectoryIsRefused) {
   auto r = load_subsystem_file(kData, registry());
   ASSERT_FALSE(r.ok());
-  EXPECT_EQ(r.error().message, kData + ": is a directory, not a subsystem file");
+  EXPECT_EQ(r.error().message, kData + ": is a directory, not a subsystem file (only regular files are read)");
 }
 
 }  // namespace
