@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "detail/remote_loader.hpp"
 #include "detail/request_loader.hpp"
 #include "detail/task_loader.hpp"
 #include "detail/yaml_reader.hpp"
@@ -192,7 +193,8 @@ Result<MapReader> read_document(const Source& source, std::string_view text) {
                                          config_detail::describe(root.node)));
   return MapReader::create(
       source, root, "the file",
-      {"subsystem", "scheduler", "cpus", "plugins", "constants", "tasks", "configurations", "start", "requests"});
+      {"subsystem", "scheduler", "cpus", "plugins", "constants", "tasks", "configurations", "start", "requests",
+       "exports", "imports", "dds"});
 }
 
 Result<SubsystemSpec> load(const Source& source, std::string_view text, const Registry& registry) {
@@ -213,6 +215,9 @@ Result<SubsystemSpec> load(const Source& source, std::string_view text, const Re
   if (auto ok = read_configurations(source, *top, spec); !ok) return ok.error();
   if (auto ok = read_start(source, *top, spec); !ok) return ok.error();
   if (auto ok = config_detail::read_requests(source, top->get("requests"), spec); !ok) return ok.error();
+  if (auto ok = config_detail::read_exports(source, top->get("exports"), spec); !ok) return ok.error();
+  if (auto ok = config_detail::read_imports(source, top->get("imports"), spec); !ok) return ok.error();
+  if (auto ok = config_detail::read_dds(source, top->get("dds"), spec); !ok) return ok.error();
   return spec;
 }
 

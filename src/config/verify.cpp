@@ -18,16 +18,18 @@ namespace {
 using config_detail::join_names;
 using config_detail::shape_text;
 
-// One end of a variable: a task's port, or `constants:` (task == nullptr).
+// One end of a variable: a task's port, or a source of the file (task == nullptr): `constants:`,
+// or `imports:` (the other subsystem that exports the variable produces it).
 struct End {
   const ResolvedTask* task = nullptr;
   const PortBinding* port = nullptr;
   VarShape shape;
+  const char* source = "constants";
 
-  [[nodiscard]] std::string name() const { return task ? task->spec->name : "constants"; }
+  [[nodiscard]] std::string name() const { return task ? task->spec->name : source; }
   // Renamed ports are named too: the variable alone would not show which output to rename back.
   [[nodiscard]] std::string label() const {
-    if (task == nullptr) return "constants";
+    if (task == nullptr) return source;
     if (port->port == port->variable) return task->spec->name;
     return fmt::format("{} (port {})", task->spec->name, port->port);
   }
@@ -51,7 +53,7 @@ std::vector<std::string> labels_of(const std::vector<End>& ends) {
 // variable. Ends are gathered in file order (not list order) so that messages do not depend on
 // how a configuration happens to list its tasks.
 struct Ends {
-  std::map<std::string, std::vector<End>> producers;  // `constants:` first
+  std::map<std::string, std::vector<End>> producers;  // `constants:` and `imports:` first
   std::map<std::string, std::vector<End>> consumers;
 };
 
@@ -61,6 +63,8 @@ Ends gather(const ResolvedSubsystem& subsystem, const std::vector<std::string>& 
     const VarShape shape{ElemType::kF64, static_cast<std::uint32_t>(value.size())};
     ends.producers[name].push_back(End{nullptr, nullptr, shape});
   }
+  for (const auto& i : subsystem.spec->imports)
+    ends.producers[i.variable].push_back(End{nullptr, nullptr, VarShape{i.type, i.count}, "imports"});
   for (const auto& t : subsystem.tasks) {
     if (std::find(task_names.begin(), task_names.end(), t.spec->name) == task_names.end()) continue;
     for (const auto& b : t.bindings)
@@ -91,11 +95,12 @@ class Report {
 void check_rule1(const Ends& ends, Report& report) {
   for (const auto& [variable, producers] : ends.producers) {
     if (producers.size() < 2) continue;
-    std::string who = join_names(labels_of(producers));
-    if (producers.front().task == nullptr) {
-      const std::vector<End> tasks(producers.begin() + 1, producers.end());
-      who = fmt::format("{} and by constants", join_names(labels_of(tasks)));
-    }
+    // The file's sources come first; they read better last: "by a and by constants".
+    const auto first_task = std::find_if(producers.begin(), producers.end(), [](const End& e) { return e.task; });
+    const std::vector<End> sources(producers.begin(), first_task);
+    const std::vector<End> tasks(first_task, producers.end());
+    std::string who = join_names(labels_of(tasks.empty() ? sources : tasks));
+    if (!tasks.empty() && !sources.empty()) who = fmt::format("{} and by {}", who, join_names(labels_of(sources)));
     report.add(1, variable, task_names_of(producers), fmt::format("rule 1: {} is produced by {}", variable, who));
   }
 }

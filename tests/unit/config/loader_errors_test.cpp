@@ -48,7 +48,7 @@ TEST(LoaderErrors, MoreThanOneDocument) {
 TEST(LoaderErrors, UnknownTopLevelKey) {
   EXPECT_EQ(error_of(std::string("subsystem: s\nschedular: rm\n") + kOneTask),
             "pid.yaml:2: schedular: unknown key (known: subsystem, scheduler, cpus, plugins, constants, tasks, "
-            "configurations, start, requests)");
+            "configurations, start, requests, exports, imports, dds)");
 }
 
 TEST(LoaderErrors, KeyWrittenTwice) {
