@@ -22,6 +22,7 @@
 #include "chimera/control/stats_json.hpp"
 #include "chimera/control/subsystem.hpp"
 #include "chimera/control/timing_table.hpp"
+#include "chimera/dds/remote_ports.hpp"
 #include "chimera/module/registry.hpp"
 #include "commands.hpp"
 #include "exit_codes.hpp"
@@ -200,6 +201,18 @@ int run_command(const RunArgs& args) {
     return kExitInvalid;
   }
 
+  // The resource ports to other subsystems: on their own ordinary threads, attached to the table.
+  std::unique_ptr<RemotePorts> remote;
+  if (spec->has_remote_variables()) {
+    auto bridge = RemotePorts::create(*spec, spec->name + options.shm_suffix);
+    if (!bridge) {
+      fmt::print(stderr, "{}: dds: {}\n", spec->file, bridge.error().message);
+      subsystem.stop();
+      return kExitInvalid;
+    }
+    remote = std::move(*bridge);
+  }
+
   const bool interactive = ::isatty(STDIN_FILENO) == 1;
   if (interactive)
     out(fmt::format("subsystem '{}' running configuration '{}' on the {} clock; type help for commands\n", spec->name,
@@ -218,6 +231,10 @@ int run_command(const RunArgs& args) {
   Session session(subsystem, gate, args, interactive);
   session.run();
   network.reset();  // the network API ends before the subsystem stops
+  if (remote) {
+    for (const auto& line : remote->take_errors()) err(line + "\n");
+    remote.reset();  // the bridge stops writing imports before the tasks stop
+  }
 
   // The figures as they stood while the tasks ran; stopping turns every task NOT-CREATED.
   const auto tasks = subsystem.snapshot();

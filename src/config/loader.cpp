@@ -10,6 +10,7 @@
 
 #include "detail/file_text.hpp"
 #include "detail/name_index.hpp"
+#include "detail/remote_loader.hpp"
 #include "detail/request_loader.hpp"
 #include "detail/task_loader.hpp"
 #include "detail/yaml_reader.hpp"
@@ -202,7 +203,7 @@ Result<MapReader> read_document(const Source& source, std::string_view text) {
   return MapReader::create(
       source, root, "the file",
       {"subsystem", "scheduler", "cpus", "plugins", "constants", "process", "tasks", "configurations", "start",
-       "requests"});
+       "requests", "exports", "imports", "dds"});
 }
 
 Result<SubsystemSpec> load(const Source& source, std::string_view text, const Registry& registry) {
@@ -225,6 +226,9 @@ Result<SubsystemSpec> load(const Source& source, std::string_view text, const Re
   if (auto ok = read_configurations(source, *top, spec, names); !ok) return ok.error();
   if (auto ok = read_start(source, *top, spec, names); !ok) return ok.error();
   if (auto ok = config_detail::read_requests(source, top->get("requests"), names, spec); !ok) return ok.error();
+  if (auto ok = config_detail::read_exports(source, top->get("exports"), spec); !ok) return ok.error();
+  if (auto ok = config_detail::read_imports(source, top->get("imports"), spec); !ok) return ok.error();
+  if (auto ok = config_detail::read_dds(source, top->get("dds"), spec); !ok) return ok.error();
   return spec;
 }
 

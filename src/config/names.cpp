@@ -28,4 +28,20 @@ std::string_view late_policy_name(LatePolicy p) {
   return "?";
 }
 
+std::string_view reliability_name(DdsReliability r) {
+  switch (r) {
+    case DdsReliability::kReliable: return "reliable";
+    case DdsReliability::kBestEffort: return "best_effort";
+  }
+  return "?";
+}
+
+std::string_view durability_name(DdsDurability d) {
+  switch (d) {
+    case DdsDurability::kVolatile: return "volatile";
+    case DdsDurability::kTransientLocal: return "transient_local";
+  }
+  return "?";
+}
+
 }  // namespace chimera

@@ -141,6 +141,7 @@ void collect_variables(Resolution& out) {
   };
   for (const auto& [name, value] : spec.constants)
     see(name, VarShape{ElemType::kF64, static_cast<std::uint32_t>(value.size())}, "constants");
+  for (const auto& i : spec.imports) see(i.variable, VarShape{i.type, i.count}, "imports");
   for (const auto& t : out.subsystem.tasks)
     for (const auto& b : t.bindings) see(b.variable, b.shape, fmt::format("task {} (port {})", t.spec->name, b.port));
 
@@ -154,6 +155,43 @@ void collect_variables(Resolution& out) {
           break;
         }
     out.violations.push_back({3, {}, variable, std::move(tasks), message});
+  }
+}
+
+// An export publishes what some task or constant of the file produces: a variable with no producer
+// anywhere would publish nothing, ever. Exports travel as Float64MultiArray, so f64 only.
+void check_exports(Resolution& out) {
+  const SubsystemSpec& spec = *out.subsystem.spec;
+  for (const auto& x : spec.exports) {
+    std::vector<std::string> producers;
+    bool produced = std::any_of(spec.constants.begin(), spec.constants.end(),
+                                [&](const auto& c) { return c.first == x.variable; });
+    for (const auto& t : out.subsystem.tasks)
+      for (const auto& b : t.bindings)
+        if (b.variable == x.variable && !is_input(b.kind)) {
+          producers.push_back(t.spec->name);
+          produced = true;
+        }
+    if (!produced) {
+      out.violations.push_back({2,
+                                {},
+                                x.variable,
+                                {},
+                                fmt::format("rule 2: {} is exported (line {}) but no task or constant of the file "
+                                            "produces it",
+                                            x.variable, x.loc.line)});
+      continue;
+    }
+    const auto var = std::find_if(out.subsystem.variables.begin(), out.subsystem.variables.end(),
+                                  [&](const VarSpec& v) { return v.name == x.variable; });
+    if (var != out.subsystem.variables.end() && var->shape.type != ElemType::kF64)
+      out.violations.push_back({3,
+                                {},
+                                x.variable,
+                                std::move(producers),
+                                fmt::format("rule 3: {} is exported (line {}) but is {}; exports travel as f64 "
+                                            "(std_msgs/msg/Float64MultiArray)",
+                                            x.variable, x.loc.line, shape_text(var->shape))});
   }
 }
 
@@ -214,6 +252,7 @@ Resolution resolve_subsystem(const SubsystemSpec& spec, const Registry& registry
 
   fill_followers(out);
   collect_variables(out);
+  check_exports(out);
   return out;
 }
 

@@ -87,6 +87,34 @@ void emit_task(YAML::Emitter& out, const TaskSpec& t) {
   out << YAML::EndMap;
 }
 
+// `exports:`, `imports:` and `dds:`, each only when the file had it or it differs from the default.
+void emit_remote(YAML::Emitter& out, const SubsystemSpec& spec) {
+  if (!spec.exports.empty()) {
+    out << YAML::Key << "exports" << YAML::Value << YAML::Flow << YAML::BeginSeq;
+    for (const auto& x : spec.exports) out << x.variable;
+    out << YAML::EndSeq;
+  }
+  if (!spec.imports.empty()) {
+    out << YAML::Key << "imports" << YAML::Value << YAML::BeginMap;
+    for (const auto& i : spec.imports) {
+      out << YAML::Key << i.variable << YAML::Value << YAML::Flow << YAML::BeginMap;
+      out << YAML::Key << "type" << YAML::Value << std::string(elem_name(i.type));
+      out << YAML::Key << "count" << YAML::Value << i.count;
+      out << YAML::Key << "max_age" << YAML::Value << duration(i.max_age_ns);
+      out << YAML::Key << "reliability" << YAML::Value << std::string(reliability_name(i.reliability));
+      out << YAML::Key << "durability" << YAML::Value << std::string(durability_name(i.durability));
+      out << YAML::EndMap;
+    }
+    out << YAML::EndMap;
+  }
+  if (spec.dds.domain != 0 || !spec.dds.partition.empty()) {
+    out << YAML::Key << "dds" << YAML::Value << YAML::Flow << YAML::BeginMap;
+    out << YAML::Key << "domain" << YAML::Value << spec.dds.domain;
+    out << YAML::Key << "partition" << YAML::Value << spec.dds.partition;
+    out << YAML::EndMap;
+  }
+}
+
 }  // namespace
 
 std::string write_subsystem_yaml(const SubsystemSpec& spec) {
@@ -129,6 +157,7 @@ std::string write_subsystem_yaml(const SubsystemSpec& spec) {
   out << YAML::Key << "tasks" << YAML::Value << YAML::BeginSeq;
   for (const auto& t : spec.tasks) emit_task(out, t);
   out << YAML::EndSeq;
+  emit_remote(out, spec);
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";
 }

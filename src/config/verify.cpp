@@ -5,6 +5,7 @@
 #include "chimera/config/verify.hpp"
 
 #include <algorithm>
+#include <string_view>
 #include <map>
 
 #include <fmt/format.h>
@@ -20,16 +21,18 @@ using config_detail::join_names;
 using config_detail::NameIndex;
 using config_detail::shape_text;
 
-// One end of a variable: a task's port, or `constants:` (task == nullptr).
+// One end of a variable: a task's port, or a source of the file (task == nullptr): `constants:`,
+// or `imports:` (the other subsystem that exports the variable produces it).
 struct End {
   const ResolvedTask* task = nullptr;
   const PortBinding* port = nullptr;
   VarShape shape;
+  const char* source = "constants";
 
-  [[nodiscard]] std::string name() const { return task ? task->spec->name : "constants"; }
+  [[nodiscard]] std::string name() const { return task ? task->spec->name : source; }
   // Renamed ports are named too: the variable alone would not show which output to rename back.
   [[nodiscard]] std::string label() const {
-    if (task == nullptr) return "constants";
+    if (task == nullptr) return source;
     if (port->port == port->variable) return task->spec->name;
     return fmt::format("{} (port {})", task->spec->name, port->port);
   }
@@ -53,7 +56,7 @@ std::vector<std::string> labels_of(const std::vector<End>& ends) {
 // variable. Ends are gathered in file order (not list order) so that messages do not depend on
 // how a configuration happens to list its tasks.
 struct Ends {
-  std::map<std::string, std::vector<End>> producers;  // `constants:` first
+  std::map<std::string, std::vector<End>> producers;  // `constants:` and `imports:` first
   std::map<std::string, std::vector<End>> consumers;
 };
 
@@ -62,12 +65,15 @@ struct Ends {
 struct FileIndex {
   NameIndex tasks;
   NameIndex constants;
+  NameIndex imports;
 
   explicit FileIndex(const ResolvedSubsystem& subsystem) {
     for (std::size_t i = 0; i < subsystem.tasks.size(); ++i)
       (void)tasks.insert(subsystem.tasks[i].spec->name, static_cast<int>(i));
     for (std::size_t i = 0; i < subsystem.spec->constants.size(); ++i)
       (void)constants.insert(subsystem.spec->constants[i].first, static_cast<int>(i));
+    for (std::size_t i = 0; i < subsystem.spec->imports.size(); ++i)
+      (void)imports.insert(subsystem.spec->imports[i].variable, static_cast<int>(i));
   }
 };
 
@@ -86,8 +92,8 @@ Ends gather(const ResolvedSubsystem& subsystem, const FileIndex& index, const st
     for (const auto& b : t.bindings)
       (is_input(b.kind) ? ends.consumers : ends.producers)[b.variable].push_back(End{&t, &b, b.shape});
   }
-  // `constants:` only where a task of the configuration uses the variable: a constant alone can
-  // break no rule. It goes first among the producers.
+  // `constants:` and `imports:` only where a task of the configuration uses the variable: alone
+  // they can break no rule. They go first among the producers, constants before imports.
   auto add_constant = [&](const std::string& variable) {
     const auto at = index.constants.find(variable);
     if (!at) return;
@@ -101,6 +107,17 @@ Ends gather(const ResolvedSubsystem& subsystem, const FileIndex& index, const st
   for (const auto& [variable, ends_of] : ends.producers) used.push_back(variable);
   for (const auto& [variable, ends_of] : ends.consumers) used.push_back(variable);
   for (const auto& variable : used) add_constant(variable);
+  for (const auto& variable : used) {
+    const auto at = index.imports.find(variable);
+    if (!at) continue;
+    const ImportSpec& import = subsystem.spec->imports[static_cast<std::size_t>(*at)];
+    auto& producers = ends.producers[variable];
+    const auto is_import = [](const End& e) { return e.task == nullptr && std::string_view(e.source) == "imports"; };
+    if (std::any_of(producers.begin(), producers.end(), is_import)) continue;  // added already
+    const bool after_constant = !producers.empty() && producers.front().task == nullptr;
+    producers.insert(producers.begin() + (after_constant ? 1 : 0),
+                     End{nullptr, nullptr, VarShape{import.type, import.count}, "imports"});
+  }
   return ends;
 }
 
@@ -126,11 +143,12 @@ class Report {
 void check_rule1(const Ends& ends, Report& report) {
   for (const auto& [variable, producers] : ends.producers) {
     if (producers.size() < 2) continue;
-    std::string who = join_names(labels_of(producers));
-    if (producers.front().task == nullptr) {
-      const std::vector<End> tasks(producers.begin() + 1, producers.end());
-      who = fmt::format("{} and by constants", join_names(labels_of(tasks)));
-    }
+    // The file's sources come first; they read better last: "by a and by constants".
+    const auto first_task = std::find_if(producers.begin(), producers.end(), [](const End& e) { return e.task; });
+    const std::vector<End> sources(producers.begin(), first_task);
+    const std::vector<End> tasks(first_task, producers.end());
+    std::string who = join_names(labels_of(tasks.empty() ? sources : tasks));
+    if (!tasks.empty() && !sources.empty()) who = fmt::format("{} and by {}", who, join_names(labels_of(sources)));
     report.add(1, variable, task_names_of(producers), fmt::format("rule 1: {} is produced by {}", variable, who));
   }
 }

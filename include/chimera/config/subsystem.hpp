@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "chimera/module/params.hpp"
+#include "chimera/svt/elem_type.hpp"
 
 namespace chimera {
 
@@ -80,6 +81,42 @@ struct SwitchRequestSpec {
   SourceLoc loc;
 };
 
+/// DDS reliability of an import's reader: reliable (the default) repairs lost samples; best
+/// effort takes what arrives, for high-rate variables where only the newest value matters.
+enum class DdsReliability { kReliable, kBestEffort };
+/// DDS durability of an import's reader: volatile (the default) sees only samples written after it
+/// matched; transient local also gets the last sample a writer wrote before.
+enum class DdsDurability { kVolatile, kTransientLocal };
+
+std::string_view reliability_name(DdsReliability r);
+std::string_view durability_name(DdsDurability d);
+
+/// A state variable published to other subsystems (top-level `exports:`).
+struct ExportSpec {
+  std::string variable;
+  SourceLoc loc;
+};
+
+/// A state variable read from another subsystem (top-level `imports:`). For verification it is
+/// produced, with this shape, by the subsystem that exports it.
+struct ImportSpec {
+  std::string variable;
+  ElemType type = ElemType::kF64;  // the wire format (Float64MultiArray) carries f64 only
+  std::uint32_t count = 0;
+  std::int64_t max_age_ns = 0;  // not written within this: stale
+  DdsReliability reliability = DdsReliability::kReliable;
+  DdsDurability durability = DdsDurability::kVolatile;
+  SourceLoc loc;
+};
+
+/// Where exports and imports meet other subsystems (top-level `dds:`). The default partition
+/// "" is DDS's default one, where ROS 2 nodes publish and subscribe.
+struct DdsSpec {
+  std::uint32_t domain = 0;
+  std::string partition;
+  SourceLoc loc;
+};
+
 struct SubsystemSpec {
   std::string name;
   std::string file;
@@ -98,6 +135,18 @@ struct SubsystemSpec {
     for (const auto& t : tasks)
       if (t.process != kMainProcess) return true;
     return false;
+  }
+
+  std::vector<ExportSpec> exports;  // in file order
+  std::vector<ImportSpec> imports;  // in file order
+  DdsSpec dds;                      // defaults when `dds:` is absent
+
+  /// True when the subsystem shares variables with other subsystems (needs the DDS bridge).
+  [[nodiscard]] bool has_remote_variables() const { return !exports.empty() || !imports.empty(); }
+  [[nodiscard]] const ImportSpec* find_import(std::string_view variable) const {
+    for (const auto& i : imports)
+      if (i.variable == variable) return &i;
+    return nullptr;
   }
 
   /// The entry that lets task `by` ask for `to` while `from` is on, or nullptr.

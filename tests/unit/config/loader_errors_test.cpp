@@ -57,7 +57,7 @@ TEST(LoaderErrors, MoreThanOneDocument) {
 TEST(LoaderErrors, UnknownTopLevelKey) {
   EXPECT_EQ(error_of(std::string("subsystem: s\nschedular: rm\n") + kOneTask),
             "pid.yaml:2: schedular: unknown key (known: subsystem, scheduler, cpus, plugins, constants, process, "
-            "tasks, configurations, start, requests)");
+            "tasks, configurations, start, requests, exports, imports, dds)");
 }
 
 TEST(LoaderErrors, KeyWrittenTwice) {

@@ -1,0 +1,387 @@
+// The bridge to other subsystems: two ordinary threads between the global table and Cyclone DDS.
+// The publisher polls the exports' versions and writes what changed; the taker waits on the
+// imports' readers, writes each sample's values into the table and judges staleness. Only they,
+// create() and the destructor call DDS.
+
+#include "chimera/dds/remote_ports.hpp"
+
+#include <dds/dds.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <mutex>
+#include <optional>
+#include <set>
+#include <thread>
+
+#include <fmt/format.h>
+
+#include "chimera/svt/global_table.hpp"
+#include "float64_multi_array.h"
+#include "sample_stamp.hpp"
+
+namespace chimera {
+namespace {
+
+using dds_detail::SampleStamp;
+using Msg = std_msgs_msg_dds__Float64MultiArray_;
+using Dim = std_msgs_msg_dds__MultiArrayDimension_;
+
+std::int64_t monotonic_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+std::int64_t wall_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+// Deletes a DDS entity (and everything it made) when it goes.
+struct Entity {
+  dds_entity_t id = 0;
+  Entity() = default;
+  explicit Entity(dds_entity_t e) : id(e) {}
+  Entity(const Entity&) = delete;
+  Entity& operator=(const Entity&) = delete;
+  ~Entity() {
+    if (id > 0) dds_delete(id);
+  }
+};
+
+struct Qos {
+  dds_qos_t* q = dds_create_qos();
+  Qos() = default;
+  Qos(const Qos&) = delete;
+  Qos& operator=(const Qos&) = delete;
+  ~Qos() { dds_delete_qos(q); }
+};
+
+struct ExportPort {
+  std::string variable;
+  VarIndex index = 0;
+  std::uint32_t count = 0;
+  dds_entity_t writer = 0;
+  dds_entity_t echo = 0;       // a reader of the same topic that ignores our own writer (eq. 1)
+  std::uint64_t seen = 0;      // the table's version last published
+  std::uint64_t sequence = 0;  // samples published
+  std::vector<double> values;
+};
+
+struct ImportPort {
+  ImportSpec spec;
+  VarIndex index = 0;
+  dds_entity_t reader = 0;
+  std::int64_t last_update_ns = 0;  // monotonic, ours; the bridge's start before the first sample
+  ImportStatus status;              // guarded by Impl::status_mutex
+};
+
+// The writer's stamp, in whichever dimension's label carries it; none from a ROS 2 node.
+std::optional<SampleStamp> stamp_of(const Msg& msg) {
+  for (std::uint32_t i = 0; i < msg.layout.dim._length; ++i)
+    if (const char* label = msg.layout.dim._buffer[i].label; label != nullptr)
+      if (auto stamp = dds_detail::parse_stamp_label(label)) return stamp;
+  return std::nullopt;
+}
+
+std::string dds_error(std::string_view what, dds_return_t rc) {
+  return fmt::format("DDS: {}: {}", what, dds_strretcode(rc));
+}
+
+}  // namespace
+
+struct RemotePorts::Impl {
+  SubsystemSpec spec;
+  RemotePortsOptions options;
+  GlobalTable table;
+  Entity participant;  // deleting it deletes every other entity it made
+  std::vector<ExportPort> exports;
+  std::vector<ImportPort> imports;
+  dds_entity_t waitset = 0;
+  dds_entity_t wake = 0;  // a guard condition that ends the taker's wait at shutdown
+
+  std::atomic<bool> stopping{false};
+  std::mutex stop_mutex;  // with stop_cv: the publisher's sleep between polls
+  std::condition_variable stop_cv;
+  std::thread publisher;
+  std::thread taker;
+
+  mutable std::mutex status_mutex;  // imports[i].status, errors, reported
+  std::vector<std::string> errors;
+  std::set<std::string> reported;  // "variable|writer" of wrong-size writers already named
+  std::optional<IllegalConfigurationHold> stale_hold;     // the taker's thread only
+  std::optional<IllegalConfigurationHold> conflict_hold;  // the taker's thread only
+
+  explicit Impl(GlobalTable t) : table(std::move(t)) {}
+
+  void publish_loop();
+  void publish(ExportPort& port);
+  void take_loop();
+  void take(ImportPort& port);
+  void check_echo(ExportPort& port);
+  void judge_staleness();
+  void report(const std::string& key, std::string message);
+};
+
+void RemotePorts::Impl::publish(ExportPort& port) {
+  const ReadOutcome got = table.read(port.index, port.values.data(), port.seen);
+  if (got.freshness != Freshness::kNew) return;
+  port.seen = got.version;
+  const std::int64_t now = wall_ns();
+  const std::string stamp = dds_detail::stamp_label(SampleStamp{spec.name, ++port.sequence, now});
+  // dim[0] is the ROS idiom for a vector of count values; dim[1] of size 1 carries the stamp.
+  Dim dims[2] = {{const_cast<char*>(port.variable.c_str()), port.count, port.count},
+                 {const_cast<char*>(stamp.c_str()), 1, 1}};
+  Msg msg{};
+  msg.layout.dim._length = msg.layout.dim._maximum = 2;
+  msg.layout.dim._buffer = dims;
+  msg.layout.data_offset = 0;
+  msg.data._length = msg.data._maximum = port.count;
+  msg.data._buffer = port.values.data();
+  if (const dds_return_t rc = dds_write_ts(port.writer, &msg, now); rc < 0)
+    report("write|" + port.variable, dds_error(fmt::format("export {}: write", port.variable), rc));
+}
+
+void RemotePorts::Impl::publish_loop() {
+  std::unique_lock lock(stop_mutex);
+  while (!stopping.load(std::memory_order_relaxed)) {  // relaxed: the flag carries no data
+    lock.unlock();
+    for (auto& port : exports) publish(port);
+    lock.lock();
+    stop_cv.wait_for(lock, std::chrono::nanoseconds(options.poll_ns),
+                     [&] { return stopping.load(std::memory_order_relaxed); });  // relaxed: as above
+  }
+}
+
+void RemotePorts::Impl::take(ImportPort& port) {
+  void* samples[1] = {nullptr};
+  dds_sample_info_t info[1];
+  while (true) {
+    const dds_return_t n = dds_take(port.reader, samples, info, 1, 1);
+    if (n <= 0) return;
+    if (info[0].valid_data) {
+      const auto* msg = static_cast<const Msg*>(samples[0]);
+      const std::optional<SampleStamp> stamp = stamp_of(*msg);
+      const std::uint32_t offset = msg->layout.data_offset;
+      const std::uint32_t length = msg->data._length >= offset ? msg->data._length - offset : 0;
+      const std::string writer = stamp ? stamp->writer : std::string();
+      if (length != port.spec.count) {
+        const std::string who = stamp ? fmt::format("subsystem {}", writer)
+                                      : fmt::format("a writer without a Chimera stamp (a ROS 2 node?, instance {:x})",
+                                                    info[0].publication_handle);
+        std::lock_guard guard(status_mutex);
+        ++port.status.refused;
+        const std::string key = fmt::format("{}|{}|{}", port.spec.variable, who, length);
+        if (reported.insert(key).second)
+          errors.push_back(fmt::format("import {}: subsystem {} reads f64[{}] but {} publishes f64[{}] on rt/{}; its "
+                                       "samples are refused",
+                                       port.spec.variable, spec.name, port.spec.count, who, length,
+                                       port.spec.variable));
+      } else {
+        table.write(port.index, msg->data._buffer + offset);
+        port.last_update_ns = monotonic_ns();
+        std::lock_guard guard(status_mutex);
+        ++port.status.samples;
+        port.status.writer = writer;
+        port.status.writer_sequence = stamp ? stamp->sequence : 0;
+        port.status.writer_time_ns = stamp ? stamp->time_ns : info[0].source_timestamp;
+      }
+    }
+    dds_return_loan(port.reader, samples, n);
+  }
+}
+
+// Eq. (1) across machines: any sample on an export's topic that is not ours comes from a second
+// producer. Both subsystems see the other's samples, so both refuse: the flag stays raised for
+// the rest of the run, since which value an importer holds is then anyone's guess.
+void RemotePorts::Impl::check_echo(ExportPort& port) {
+  void* samples[1] = {nullptr};
+  dds_sample_info_t info[1];
+  while (true) {
+    const dds_return_t n = dds_take(port.echo, samples, info, 1, 1);
+    if (n <= 0) return;
+    if (info[0].valid_data) {
+      const auto* msg = static_cast<const Msg*>(samples[0]);
+      const std::optional<SampleStamp> stamp = stamp_of(*msg);
+      const std::string who = stamp ? fmt::format("subsystem {}", stamp->writer)
+                                    : std::string("a writer without a Chimera stamp (a ROS 2 node?)");
+      report(fmt::format("rule1|{}|{}", port.variable, who),
+             fmt::format("rule 1: {} is exported by subsystem {} and by {} on rt/{}; the illegal-configuration "
+                         "flag stays raised",
+                         port.variable, spec.name, who, port.variable));
+      if (!conflict_hold) conflict_hold.emplace(table);
+    }
+    dds_return_loan(port.echo, samples, n);
+  }
+}
+
+void RemotePorts::Impl::judge_staleness() {
+  const std::int64_t now = monotonic_ns();
+  bool any_stale = false;
+  {
+    std::lock_guard guard(status_mutex);
+    for (auto& port : imports) {
+      port.status.stale = now - port.last_update_ns > port.spec.max_age_ns;
+      any_stale = any_stale || port.status.stale;
+    }
+  }
+  if (!options.hold_when_stale) return;
+  if (any_stale && !stale_hold) stale_hold.emplace(table);
+  if (!any_stale) stale_hold.reset();
+}
+
+void RemotePorts::Impl::take_loop() {
+  // Wake at least this often to judge staleness; a tenth of the tightest max_age bounds how late.
+  std::int64_t tick = options.poll_ns * 10;
+  for (const auto& port : imports) tick = std::min(tick, std::max<std::int64_t>(port.spec.max_age_ns / 10, 100'000));
+  std::vector<dds_attach_t> triggered(imports.size() + 1 + exports.size());
+  while (!stopping.load(std::memory_order_relaxed)) {  // relaxed: the flag carries no data
+    const dds_return_t n =
+        dds_waitset_wait(waitset, triggered.data(), triggered.size(), static_cast<dds_duration_t>(tick));
+    for (dds_return_t i = 0; i < n; ++i) {
+      const auto which = static_cast<std::size_t>(triggered[static_cast<std::size_t>(i)]);
+      if (which < imports.size()) take(imports[which]);
+      if (which > imports.size() && which - imports.size() - 1 < exports.size())
+        check_echo(exports[which - imports.size() - 1]);
+    }
+    judge_staleness();
+  }
+  stale_hold.reset();
+  conflict_hold.reset();
+}
+
+void RemotePorts::Impl::report(const std::string& key, std::string message) {
+  std::lock_guard guard(status_mutex);
+  if (reported.insert(key).second) errors.push_back(std::move(message));
+}
+
+RemotePorts::RemotePorts(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+
+RemotePorts::~RemotePorts() {
+  impl_->stopping.store(true, std::memory_order_relaxed);  // relaxed: the joins below order the rest
+  {
+    std::lock_guard lock(impl_->stop_mutex);  // so the publisher cannot miss the notification
+  }
+  impl_->stop_cv.notify_all();
+  if (impl_->wake > 0) dds_set_guardcondition(impl_->wake, true);
+  if (impl_->publisher.joinable()) impl_->publisher.join();
+  if (impl_->taker.joinable()) impl_->taker.join();
+}
+
+namespace {
+
+Result<void> check_shape(const GlobalTable& table, const std::string& variable, std::uint32_t count,
+                         std::string_view role, VarIndex& index) {
+  const auto found = table.find(variable);
+  if (!found)
+    return make_error(Errc::kInvalidInput, fmt::format("{} {}: not a variable of table {}", role, variable,
+                                                       table.shm_name()));
+  const VarShape shape = table.shape(*found);
+  if (shape.type != ElemType::kF64 || (count != 0 && shape.count != count))
+    return make_error(Errc::kInvalidInput, fmt::format("{} {}: the table holds it as {}[{}], not f64[{}]", role,
+                                                       variable, elem_name(shape.type), shape.count, count));
+  index = *found;
+  return {};
+}
+
+}  // namespace
+
+Result<std::unique_ptr<RemotePorts>> RemotePorts::create(const SubsystemSpec& spec, std::string_view table_name,
+                                                         RemotePortsOptions options) {
+  auto table = GlobalTable::attach(table_name);
+  if (!table) return table.error();
+  auto impl = std::make_unique<Impl>(std::move(*table));
+  impl->spec = spec;
+  impl->options = options;
+  Impl& m = *impl;
+
+  m.participant.id = dds_create_participant(static_cast<dds_domainid_t>(spec.dds.domain), nullptr, nullptr);
+  if (m.participant.id < 0)
+    return make_error(Errc::kInvalidInput, dds_error(fmt::format("domain {}", spec.dds.domain), m.participant.id));
+  Qos group;
+  if (!spec.dds.partition.empty()) dds_qset_partition1(group.q, spec.dds.partition.c_str());
+  const dds_entity_t publisher = dds_create_publisher(m.participant.id, group.q, nullptr);
+  const dds_entity_t subscriber = dds_create_subscriber(m.participant.id, group.q, nullptr);
+  if (publisher < 0 || subscriber < 0)
+    return make_error(Errc::kInvalidInput, dds_error("publisher and subscriber", std::min(publisher, subscriber)));
+  // Attached to the waitset as: import i -> i, the wake-up -> imports.size(), export k's echo ->
+  // imports.size() + 1 + k.
+  m.waitset = dds_create_waitset(m.participant.id);
+  m.wake = dds_create_guardcondition(m.participant.id);
+  if (m.waitset < 0 || m.wake < 0 ||
+      dds_waitset_attach(m.waitset, m.wake, static_cast<dds_attach_t>(spec.imports.size())) < 0)
+    return make_error(Errc::kInvalidInput, dds_error("waitset", std::min(m.waitset, m.wake)));
+  auto topic = [&](const std::string& variable) {
+    return dds_create_topic(m.participant.id, &std_msgs_msg_dds__Float64MultiArray__desc,
+                            ("rt/" + variable).c_str(), nullptr, nullptr);
+  };
+
+  for (const auto& x : spec.exports) {
+    ExportPort port;
+    port.variable = x.variable;
+    if (auto ok = check_shape(m.table, x.variable, 0, "export", port.index); !ok) return ok.error();
+    port.count = m.table.shape(port.index).count;
+    port.values.resize(port.count);
+    const dds_entity_t t = topic(x.variable);
+    // The strongest offer matches every reader: reliable, and the last value kept for late joiners.
+    Qos qos;
+    dds_qset_history(qos.q, DDS_HISTORY_KEEP_LAST, 1);
+    dds_qset_reliability(qos.q, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
+    dds_qset_durability(qos.q, DDS_DURABILITY_TRANSIENT_LOCAL);
+    port.writer = t < 0 ? t : dds_create_writer(publisher, t, qos.q, nullptr);
+    // The echo hears every other writer of the topic in the partition, never this participant's.
+    Qos echo_qos;
+    dds_qset_history(echo_qos.q, DDS_HISTORY_KEEP_LAST, 1);
+    dds_qset_reliability(echo_qos.q, DDS_RELIABILITY_BEST_EFFORT, 0);
+    dds_qset_ignorelocal(echo_qos.q, DDS_IGNORELOCAL_PARTICIPANT);
+    port.echo = port.writer < 0 ? port.writer : dds_create_reader(subscriber, t, echo_qos.q, nullptr);
+    const dds_entity_t heard = port.echo < 0 ? port.echo : dds_create_readcondition(port.echo, DDS_ANY_STATE);
+    if (heard < 0 || dds_waitset_attach(m.waitset, heard,
+                                        static_cast<dds_attach_t>(spec.imports.size() + 1 + m.exports.size())) < 0)
+      return make_error(Errc::kInvalidInput, dds_error(fmt::format("export {}", x.variable), heard));
+    m.exports.push_back(std::move(port));
+  }
+  const std::int64_t start = monotonic_ns();
+  for (const auto& i : spec.imports) {
+    ImportPort port;
+    port.spec = i;
+    port.status.variable = i.variable;
+    port.last_update_ns = start;
+    if (auto ok = check_shape(m.table, i.variable, i.count, "import", port.index); !ok) return ok.error();
+    const dds_entity_t t = topic(i.variable);
+    Qos qos;
+    dds_qset_history(qos.q, DDS_HISTORY_KEEP_LAST, 1);
+    dds_qset_reliability(qos.q,
+                         i.reliability == DdsReliability::kReliable ? DDS_RELIABILITY_RELIABLE
+                                                                     : DDS_RELIABILITY_BEST_EFFORT,
+                         DDS_MSECS(100));
+    dds_qset_durability(qos.q, i.durability == DdsDurability::kTransientLocal ? DDS_DURABILITY_TRANSIENT_LOCAL
+                                                                               : DDS_DURABILITY_VOLATILE);
+    port.reader = t < 0 ? t : dds_create_reader(subscriber, t, qos.q, nullptr);
+    const dds_entity_t ready = port.reader < 0 ? port.reader : dds_create_readcondition(port.reader, DDS_ANY_STATE);
+    if (ready < 0 ||
+        dds_waitset_attach(m.waitset, ready, static_cast<dds_attach_t>(m.imports.size())) < 0)
+      return make_error(Errc::kInvalidInput, dds_error(fmt::format("import {}", i.variable), ready));
+    m.imports.push_back(std::move(port));
+  }
+
+  if (!m.exports.empty()) m.publisher = std::thread([&m] { m.publish_loop(); });
+  m.taker = std::thread([&m] { m.take_loop(); });  // also the exports' echoes
+  return std::unique_ptr<RemotePorts>(new RemotePorts(std::move(impl)));
+}
+
+std::vector<ImportStatus> RemotePorts::imports() const {
+  std::lock_guard guard(impl_->status_mutex);
+  std::vector<ImportStatus> out;
+  out.reserve(impl_->imports.size());
+  for (const auto& port : impl_->imports) out.push_back(port.status);
+  return out;
+}
+
+std::vector<std::string> RemotePorts::take_errors() {
+  std::lock_guard guard(impl_->status_mutex);
+  return std::exchange(impl_->errors, {});
+}
+
+}  // namespace chimera
