@@ -97,7 +97,10 @@ Result<void> read_exports(const Source& source, const std::optional<Field>& fiel
 Result<void> read_imports(const Source& source, const std::optional<Field>& field, SubsystemSpec& spec) {
   if (!field || field->node.IsNull()) return {};
   if (auto ok = check_free_keys(source, *field, "imports"); !ok) return ok.error();
-  for (const auto& [value, name] : entries(*field)) {
+  for (const auto& entry : entries(*field)) {
+    // Named, not bound: clang 14 (the fuzz tree's compiler) cannot capture a structured binding.
+    const auto& value = entry.first;
+    const auto& name = entry.second;
     if (!is_identifier(name))
       return source.fail(value, "not a valid variable name (letters, digits and _, not starting with a digit)");
     const bool exported = std::any_of(spec.exports.begin(), spec.exports.end(),
