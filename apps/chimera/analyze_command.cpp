@@ -23,10 +23,12 @@
 #include "chimera/control/timing_table.hpp"
 #include "chimera/core/duration_text.hpp"
 #include "chimera/module/registry.hpp"
+#include "chimera/svt/global_table.hpp"
 #include "commands.hpp"
 #include "exit_codes.hpp"
 #include "load_file.hpp"
 #include "measure.hpp"
+#include "stop_request.hpp"
 
 namespace chimera::cli {
 namespace {
@@ -145,6 +147,12 @@ int analyze_command(const AnalyzeArgs& args) {
   }
   const Resolution resolution = resolve_subsystem(*spec, Registry::global());
   if (!legal(*spec, resolution, args.config)) return kExitInvalid;
+  // A signal ends a measuring run cleanly, its shared memory removed; the regions of an earlier
+  // analyze that was killed outright (its pid in their names, so never made again) go now.
+  install_stop_handlers();
+  if (const std::size_t stale = GlobalTable::reclaim_stale(spec->name + "_measure_"); stale > 0)
+    fmt::print(stderr, "removed {} shared memory region{} left by an earlier chimera analyze\n", stale,
+               stale == 1 ? "" : "s");
   const analysis::ReleaseOrder order = analysis::compute_release_order(resolution.subsystem);
 
   const analysis::AnalysisOptions options{.overhead_ns = args.overhead_ns};

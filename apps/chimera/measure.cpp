@@ -9,7 +9,10 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "chimera/core/duration_text.hpp"
+#include "chimera/exec/clock.hpp"
 #include "chimera/module/registry.hpp"
+#include "stop_request.hpp"
 
 namespace chimera::cli {
 
@@ -17,9 +20,15 @@ namespace {
 
 constexpr std::int64_t kMinMeasureNs = 1'000'000'000;
 constexpr std::int64_t kPeriodsMeasured = 20;
+// Releases of one measuring run, every task together: at a few microseconds each on the virtual
+// clock, seconds of host time. A file of many fast tasks is measured for a shorter time.
+constexpr double kMostReleases = 2'000'000;
+// The measuring runs are made in slices, so that a signal or the host-time limit ends them
+// between two slices (and the regions go with the subsystem's stop()).
+constexpr std::int64_t kSliceNs = 10'000'000;
 
 Result<std::vector<TaskSnapshot>> measure_once(const SubsystemSpec& spec, const std::string& configuration,
-                                               ClockKind clock, std::int64_t for_ns) {
+                                               ClockKind clock, std::int64_t for_ns, std::int64_t host_deadline_ns) {
   static int runs = 0;  // one process may measure several times, one run after the other
   RunOptions options;
   options.clock = clock;
@@ -34,7 +43,19 @@ Result<std::vector<TaskSnapshot>> measure_once(const SubsystemSpec& spec, const 
     subsystem.stop();
     return started.error();
   }
-  subsystem.run_for(for_ns);
+  for (std::int64_t done = 0; done < for_ns;) {
+    const std::int64_t slice = std::min(kSliceNs, for_ns - done);
+    subsystem.run_for(slice);
+    done += slice;
+    if (done < for_ns && (stop_requested() || monotonic_ns() > host_deadline_ns)) {
+      subsystem.stop();
+      if (stop_requested()) return make_error(Errc::kState, "stopped by a signal while measuring");
+      return make_error(Errc::kInvalidInput,
+                        fmt::format("the measuring run took more than {} s of host time ({} of {} simulated); give "
+                                    "the tasks wcet: or a profile with --wcet-from",
+                                    kMeasureHostLimitNs / 1'000'000'000, format_duration(done), format_duration(for_ns)));
+    }
+  }
   auto tasks = subsystem.snapshot();
   subsystem.stop();
   for (const auto& e : subsystem.drain_events()) spdlog::warn("while measuring, task {}: {}", e.task, e.text);
@@ -52,18 +73,26 @@ std::int64_t longest_cycle_ns(const TaskStatsSnapshot& s) {
 
 std::int64_t measurement_length_ns(const SubsystemSpec& spec, const std::string& configuration) {
   std::int64_t longest = 0;
+  double releases_per_ns = 0;
   if (const ConfigurationSpec* c = spec.find_configuration(configuration))
     for (const auto& name : c->tasks)
-      if (const TaskSpec* t = spec.find_task(name)) longest = std::max(longest, t->period_ns.value_or(0));
-  return std::max(kMinMeasureNs, kPeriodsMeasured * longest);
+      if (const TaskSpec* t = spec.find_task(name); t != nullptr && t->period_ns.value_or(0) > 0) {
+        longest = std::max(longest, *t->period_ns);
+        releases_per_ns += 1.0 / static_cast<double>(*t->period_ns);
+      }
+  const std::int64_t wanted = std::max(kMinMeasureNs, kPeriodsMeasured * longest);
+  if (releases_per_ns * static_cast<double>(wanted) <= kMostReleases) return wanted;
+  // Too many releases: as many as the bound allows, but one period of the slowest task at least.
+  return std::max(longest, static_cast<std::int64_t>(kMostReleases / releases_per_ns));
 }
 
 Result<analysis::WcetProfile> measure_profile(const SubsystemSpec& spec, const std::string& configuration,
                                               ClockKind clock, std::int64_t for_ns, int runs, double margin,
                                               double simulated_margin) {
   std::vector<TaskSnapshot> least;  // per task: the run with the shortest longest cycle
+  const std::int64_t host_deadline_ns = monotonic_ns() + kMeasureHostLimitNs;
   for (int run = 0; run < runs; ++run) {
-    auto tasks = measure_once(spec, configuration, clock, for_ns);
+    auto tasks = measure_once(spec, configuration, clock, for_ns, host_deadline_ns);
     if (!tasks) return tasks.error();
     if (least.empty()) {
       least = *std::move(tasks);

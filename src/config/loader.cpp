@@ -39,6 +39,12 @@ Result<void> read_name(const Source& source, const MapReader& top, SubsystemSpec
     return source.fail(*f, fmt::format("\"{}\" is not a valid subsystem name (letters, digits and _ only: it names "
                                        "the subsystem's shared memory)",
                                        *name));
+  // Room for what a run adds to it: the region's prefix and, for analyze's measuring runs, a
+  // suffix with the pid (the shared memory's limit is 200 characters in all).
+  constexpr std::size_t kLongestName = 160;
+  if (name->empty() || name->size() > kLongestName)
+    return source.fail(*f, fmt::format("a subsystem name has 1 to {} characters, this one {}", kLongestName,
+                                       name->size()));
   spec.name = *std::move(name);
   return {};
 }

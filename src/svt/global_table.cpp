@@ -13,6 +13,7 @@
 #include <atomic>
 #include <cerrno>
 #include <cstring>
+#include <filesystem>
 #include <limits>
 #include <new>
 #include <set>
@@ -326,6 +327,21 @@ void GlobalTable::release() noexcept {
 }
 
 void GlobalTable::remove_owned_names_now() noexcept { svt_detail::remove_owned_names_now(); }
+
+std::size_t GlobalTable::reclaim_stale(std::string_view name_prefix) {
+  const std::string prefix = fmt::format("chimera_{}", name_prefix);
+  std::error_code ec;
+  std::vector<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(svt_detail::kShmDir, ec))
+    if (const std::string name = entry.path().filename().string(); name.rfind(prefix, 0) == 0) names.push_back(name);
+  std::size_t reclaimed = 0;
+  for (const auto& name : names) {
+    // inspect_existing() removes the name only when nobody holds the region's lock.
+    auto existing = svt_detail::inspect_existing(svt_detail::shm_path("/" + name), "/" + name);
+    if (existing && existing->kind == svt_detail::Existing::Kind::kReclaimed) ++reclaimed;
+  }
+  return reclaimed;
+}
 
 void GlobalTable::locate_blocks() {
   const auto* header = object_at<Header>(base_, 0);

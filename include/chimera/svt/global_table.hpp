@@ -43,6 +43,11 @@ class GlobalTable {
   /// is still that region's: for a signal handler about to end the process the abrupt way, so
   /// that no region is left behind. The mappings stay valid. Async-signal-safe.
   static void remove_owned_names_now() noexcept;
+  /// Removes every stale region (its owner gone, however it ended) whose subsystem name starts
+  /// with `name_prefix`, e.g. the measuring runs of a killed `chimera analyze`, whose names carry
+  /// their pid and so are never created again. Live ones are left. Returns how many it removed.
+  /// Not real-time safe.
+  static std::size_t reclaim_stale(std::string_view name_prefix);
   /// Maps an existing region read-write, e.g. from another process. A region of another layout
   /// (detail/shm_layout.hpp's fingerprint differs: another version of Chimera made it) is refused
   /// with a message saying so. Not real-time safe.

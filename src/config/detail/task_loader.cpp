@@ -6,10 +6,16 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "chimera/core/duration_text.hpp"
+
 namespace chimera::config_detail {
 namespace {
 
 constexpr int kMaxUserPriority = 1000;
+// The shortest period a task may have. The real clock's timer, wake-up and the framework's own
+// cycle take microseconds, so a shorter period cannot run there, and on the virtual clock it would
+// only make a measuring run (chimera analyze) run billions of cycles.
+constexpr std::int64_t kShortestPeriodNs = 10'000;
 
 Result<const ModuleInfo*> read_module(const Source& source, const Field& field, const Registry& registry) {
   auto name = read_text(source, field);
@@ -32,6 +38,10 @@ Result<void> read_timing(const Source& source, const MapReader& map, TaskSpec& t
     auto ns = period ? read_duration(source, f) : read_frequency_period(source, f);
     if (!ns) return ns.error();
     if (*ns <= 0) return source.fail(f, "must be greater than zero");
+    if (*ns < kShortestPeriodNs)
+      return source.fail(f, fmt::format("{}{} is shorter than {}, the shortest period a task can be released at",
+                                        f.node.Scalar(), period ? "" : fmt::format(" (a period of {})", format_period(*ns)),
+                                        format_period(kShortestPeriodNs)));
     task.period_ns = *ns;
   }
   task.deadline_ns = task.period_ns.value_or(0);  // an aperiodic task without a deadline has none (0)

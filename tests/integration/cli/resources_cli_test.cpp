@@ -2,7 +2,8 @@
 // left (a small tmpfs mounted over it in a mount namespace of the test's own), a log on /dev/full
 // and on a disk that fills during the run, shared memory left by a run killed with SIGKILL
 // (its pid dead, or its pid now a live unrelated process's), two live runs of one name, and
-// every sequence of SIGINT, SIGTERM and SIGHUP sent to a running process.
+// every sequence of SIGINT, SIGTERM and SIGHUP sent to a running process; `chimera analyze`'s
+// measuring runs stopped by a signal or killed outright.
 
 #include <fcntl.h>
 #include <signal.h>
@@ -307,6 +308,67 @@ TEST_F(ResourcesCliTest, NoSequenceOfStopSignalsLeavesTheRegionBehind) {
       EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << said << status << "\n" << run.output();
       EXPECT_TRUE(contains(run.output(), "latency p99")) << said << run.output();
     }
+}
+
+// A file whose measuring runs take seconds: 200 tasks at 100 us, two million releases a run.
+std::string slow_to_measure(const std::string& name) {
+  std::string yaml = "subsystem: " + name + "\ntasks:\n";
+  for (int i = 0; i < 200; ++i)
+    yaml += "  - { name: t" + std::to_string(i) + ", module: cpu_load, period: 100us, criticality: soft }\n";
+  return yaml;
+}
+
+// The shared memory of `name`'s measuring runs (chimera_NAME_measure_PID_N).
+std::vector<std::string> measure_regions(const std::string& name) {
+  std::vector<std::string> found;
+  const std::string prefix = "chimera_" + name + "_measure_";
+  for (const auto& e : std::filesystem::directory_iterator("/dev/shm"))
+    if (e.path().filename().string().starts_with(prefix)) found.push_back(e.path().string());
+  return found;
+}
+
+bool wait_for_measure_region(const std::string& name) {
+  for (int i = 0; i < 3000; ++i) {
+    if (!measure_regions(name).empty()) return true;
+    std::this_thread::sleep_for(10ms);
+  }
+  return false;
+}
+
+TEST_F(ResourcesCliTest, AnalyzeStoppedByASignalWhileMeasuringExits2AndLeavesNoRegion) {
+  const std::string n = name("measure_term");
+  const std::string f = dir_.file(n + ".yaml");
+  write_text(f, slow_to_measure(n));
+  RunningChimera run(dir_, {"analyze", f});
+  ASSERT_TRUE(wait_for_measure_region(n)) << run.output();
+  run.signal(SIGTERM);
+  const int status = run.wait(60s);
+  ASSERT_NE(status, -1) << "analyze did not end";
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 2) << status << "\n" << run.output();
+  EXPECT_TRUE(contains(run.output(), "stopped by a signal while measuring")) << run.output();
+  EXPECT_TRUE(measure_regions(n).empty()) << measure_regions(n).front();
+}
+
+TEST_F(ResourcesCliTest, TheRegionOfAnAnalyzeKilledOutrightIsRemovedByTheNextAnalyze) {
+  const std::string n = name("measure_kill");
+  const std::string f = dir_.file(n + ".yaml");
+  write_text(f, slow_to_measure(n));
+  {
+    RunningChimera run(dir_, {"analyze", f});
+    ASSERT_TRUE(wait_for_measure_region(n)) << run.output();
+    run.signal(SIGKILL);
+    ASSERT_NE(run.wait(30s), -1);
+  }
+  const auto left = measure_regions(n);
+  ASSERT_EQ(left.size(), 1u) << "SIGKILL leaves the measuring run's region behind";
+  for (const auto& path : left) names_.push_back(path.substr(std::string("/dev/shm/chimera_").size()));
+  // The next analyze of that subsystem, a quick one, removes it (its pid is in its name, so no
+  // run of that name would ever be made again).
+  write_text(f, "subsystem: " + n + "\ntasks:\n  - { name: t, module: cpu_load, period: 1ms, criticality: soft }\n");
+  const auto o = chimera("analyze " + quoted(f));
+  EXPECT_EXIT_CODE(o, 0) << o.err;
+  EXPECT_TRUE(contains(o.err, "removed 1 shared memory region left by an earlier chimera analyze")) << o.err;
+  EXPECT_TRUE(measure_regions(n).empty());
 }
 
 }  // namespace

@@ -211,6 +211,16 @@ tasks:
             "pid.yaml:14: tasks[2].period: \"10 ms\" is not a duration (use ns, us, ms or s, e.g. 10ms)");
 }
 
+TEST(LoaderErrors, SubsystemNamesThatEveryCommandCanUse) {
+  // verify must refuse what run or analyze would (their shared memory names add to it).
+  const std::string tail = "\ntasks:\n  - {name: a, module: visual_servo, period: 1ms}\n";
+  EXPECT_EQ(error_of("subsystem: " + std::string(161, 'n') + tail),
+            "pid.yaml:1: subsystem: a subsystem name has 1 to 160 characters, this one 161");
+  EXPECT_TRUE(load_subsystem_text("subsystem: " + std::string(160, 'n') + tail, "pid.yaml",
+                                  test::config_test_registry())
+                  .ok());
+}
+
 TEST(LoaderErrors, BadPeriods) {
   const std::string head = "subsystem: s\ntasks:\n  - name: a\n    module: visual_servo\n";
   EXPECT_EQ(error_of(head + "    period: 0ms\n"), "pid.yaml:5: tasks[0].period: must be greater than zero");
@@ -222,6 +232,14 @@ TEST(LoaderErrors, BadPeriods) {
             "pid.yaml:5: tasks[0].period: a list is not a duration (use ns, us, ms or s, e.g. 10ms)");
   EXPECT_EQ(error_of(head + "    period:\n"),
             "pid.yaml:5: tasks[0].period: nothing is not a duration (use ns, us, ms or s, e.g. 10ms)");
+  // A period that cannot run (and would make analyze's measuring run take hours).
+  EXPECT_EQ(error_of(head + "    period: 1ns\n"),
+            "pid.yaml:5: tasks[0].period: 1ns is shorter than 10 µs, the shortest period a task can be released at");
+  EXPECT_EQ(error_of(head + "    frequency: 200kHz\n"),
+            "pid.yaml:5: tasks[0].frequency: 200kHz (a period of 5 µs) is shorter than 10 µs, the shortest period a "
+            "task can be released at");
+  EXPECT_TRUE(load_subsystem_text(head + "    period: 10us\n", "pid.yaml", test::config_test_registry()).ok())
+      << "the shortest period is allowed";
 }
 
 TEST(LoaderErrors, PeriodAndFrequencyTogether) {

@@ -221,6 +221,34 @@ TEST(GlobalTableLifetime, AStaleRegionIsReplacedWhateverBecameOfItsPid) {
   }
 }
 
+TEST(GlobalTableLifetime, ReclaimStaleRemovesTheDeadOnesOfAPrefixOnly) {
+  // Two regions left by a dead process under the prefix, one live region under it, and one left
+  // by the dead process under another name.
+  const auto prefix = unique_subsystem("sweep") + "_measure_";
+  const auto other = unique_subsystem("unswept");
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    auto a = GlobalTable::create(prefix + "1_0", fig4_vars());
+    auto b = GlobalTable::create(prefix + "1_1", fig4_vars());
+    auto c = GlobalTable::create(other, fig4_vars());
+    ::_exit(a && b && c ? 0 : 1);  // no destructors: the regions stay, their locks go
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+  auto live = GlobalTable::create(prefix + "2_0", fig4_vars());
+  ASSERT_TRUE(live) << live.error().message;
+
+  EXPECT_EQ(GlobalTable::reclaim_stale(prefix), 2U);
+  EXPECT_FALSE(exists(dev_shm_path(prefix + "1_0")));
+  EXPECT_FALSE(exists(dev_shm_path(prefix + "1_1")));
+  EXPECT_TRUE(exists(dev_shm_path(prefix + "2_0"))) << "a live region is left";
+  EXPECT_TRUE(exists(dev_shm_path(other))) << "another prefix is left";
+  EXPECT_EQ(GlobalTable::reclaim_stale(prefix), 0U);
+  EXPECT_EQ(GlobalTable::reclaim_stale(other), 1U);
+}
+
 TEST(GlobalTableLifetime, TheSignalTimeRemovalTakesOnlyThisProcesssOwnNames) {
   const auto name = unique_subsystem("abrupt");
   auto old_owner = GlobalTable::create(name, fig4_vars());
