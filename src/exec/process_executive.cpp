@@ -1,5 +1,6 @@
 #include "process_executive.hpp"
 
+#include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
 #include <sys/syscall.h>
@@ -9,9 +10,9 @@
 #include <pthread.h>
 
 #include <algorithm>
+#include <array>
+#include <charconv>
 #include <cerrno>
-#include <fstream>
-#include <iterator>
 #include <sstream>
 #include <map>
 #include <mutex>
@@ -166,15 +167,24 @@ void ProcessExecutive::watch_life(ModuleProcess& p, std::uint64_t generation, pi
   // wait status as waitid will give it); "" when it cannot be read.
   std::string how;
   {
-    std::ifstream stat(fmt::format("/proc/{}/stat", pid));
-    std::string text((std::istreambuf_iterator<char>(stat)), std::istreambuf_iterator<char>());
+    // read(2), not a stream: a process already reaped makes the read fail with ESRCH, which
+    // libstdc++'s filebuf throws as an exception no iterator catches (it ended the test runner).
+    std::string text;
+    const std::string path = fmt::format("/proc/{}/stat", pid);
+    if (const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC); fd >= 0) {
+      std::array<char, 1024> buffer{};
+      ssize_t got = 0;
+      while ((got = ::read(fd, buffer.data(), buffer.size())) > 0) text.append(buffer.data(), static_cast<std::size_t>(got));
+      ::close(fd);
+    }
     const auto paren = text.rfind(')');
     if (paren != std::string::npos) {
       std::istringstream fields(text.substr(paren + 1));
       std::string field;
       // Fields from the 3rd (state) on: exit_code is the 52nd.
       for (int n = 3; n <= 52 && fields >> field; ++n)
-        if (n == 52) how = ModuleProcess::exit_text(std::stoi(field));
+        if (int code = 0; n == 52 && std::from_chars(field.data(), field.data() + field.size(), code).ec == std::errc{})
+          how = ModuleProcess::exit_text(code);
     }
   }
   if (locked == EOWNERDEAD) pthread_mutex_consistent(life);
