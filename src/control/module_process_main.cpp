@@ -23,8 +23,8 @@ namespace chimera {
 
 namespace {
 
-void reply(int socket_fd, const Result<void>& r) {
-  const ProcessReply message = ProcessReply::from(r);
+void reply(int socket_fd, const Result<void>& r, std::int64_t value = -1) {
+  const ProcessReply message = ProcessReply::from(r, value);
   (void)::send(socket_fd, &message, sizeof message, MSG_NOSIGNAL);
 }
 
@@ -33,26 +33,25 @@ std::vector<std::size_t> indices(const std::array<std::uint32_t, ProcessCommand:
   return {list.begin(), list.begin() + static_cast<std::ptrdiff_t>(count)};
 }
 
-Result<void> commit(Executive& executive, const ProcessCommand& c, const std::vector<bool>& mine,
-                    const ResolvedSubsystem& resolved) {
+CommitOutcome commit(Executive& executive, const ProcessCommand& c, const std::vector<bool>& mine,
+                     const ResolvedSubsystem& resolved) {
   SwitchCommit part;
   part.leaving = indices(c.tasks, c.count);
   part.joining = indices(c.joining, c.joining_count);
   for (const std::size_t i : indices(c.target, c.target_count)) {
-    if (i >= resolved.tasks.size()) return make_error(Errc::kInvalidInput, fmt::format("no task {}", i));
+    if (i >= resolved.tasks.size()) return {-1, make_error(Errc::kInvalidInput, fmt::format("no task {}", i))};
     part.target.push_back(resolved.tasks[i].spec->name);
   }
   for (const auto* list : {&part.leaving, &part.joining})
     for (const std::size_t i : *list)
-      if (i >= mine.size() || !mine[i]) return make_error(Errc::kInvalidInput, fmt::format("task {} is not mine", i));
+      if (i >= mine.size() || !mine[i])
+        return {-1, make_error(Errc::kInvalidInput, fmt::format("task {} is not mine", i))};
   part.at_ns = c.at_ns;
   part.part = static_cast<SwitchCommit::Part>(c.part);
   return executive.commit_switch(part);
 }
 
-Result<void> carry_out(Executive& executive, const ProcessCommand& c, const std::vector<bool>& mine,
-                       const ResolvedSubsystem& resolved) {
-  if (c.kind == ProcessCommandKind::kCommit) return commit(executive, c, mine, resolved);
+Result<void> carry_out(Executive& executive, const ProcessCommand& c, const std::vector<bool>& mine) {
   const std::vector<std::size_t> tasks = indices(c.tasks, c.count);
   for (const std::size_t i : tasks)
     if (i >= mine.size() || !mine[i]) return make_error(Errc::kInvalidInput, fmt::format("task {} is not mine", i));
@@ -145,7 +144,12 @@ int run_module_process(const SubsystemSpec& spec, const Registry& registry, cons
       reply(sock, Result<void>{});
       return 0;
     }
-    reply(sock, carry_out(*executive, c, mine, resolved));
+    if (c.kind == ProcessCommandKind::kCommit) {
+      const CommitOutcome outcome = commit(*executive, c, mine, resolved);
+      reply(sock, outcome.fault, outcome.joins_from_ns);
+      continue;
+    }
+    reply(sock, carry_out(*executive, c, mine));
   }
 }
 

@@ -353,6 +353,11 @@ GlobalTable& SubsystemTestAccess::table(Subsystem& subsystem) {
   return *subsystem.impl_->table;
 }
 
+Executive& SubsystemTestAccess::executive(Subsystem& subsystem) {
+  CHIMERA_INVARIANT(subsystem.impl_->executive != nullptr, "SubsystemTestAccess::executive() after stop()");
+  return *subsystem.impl_->executive;
+}
+
 bool Subsystem::hard_task_failed() const {
   const Impl& m = *impl_;
   std::shared_lock<std::shared_mutex> runtime(m.runtime_mutex);

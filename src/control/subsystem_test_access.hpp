@@ -5,6 +5,7 @@
 
 #include "chimera/control/subsystem.hpp"
 #include "chimera/svt/global_table.hpp"
+#include "exec/executive.hpp"
 
 namespace chimera {
 
@@ -12,6 +13,9 @@ class SubsystemTestAccess {
  public:
   /// The table of a subsystem that has not been stopped.
   static GlobalTable& table(Subsystem& subsystem);
+  /// The executive of a subsystem that has not been stopped: to post a switch's commit at an
+  /// instant of the test's choosing (one already past: a commit posted late).
+  static Executive& executive(Subsystem& subsystem);
 };
 
 }  // namespace chimera

@@ -79,6 +79,15 @@ struct SwitchCommit {
   enum class Part : std::uint8_t { kWhole, kLeave, kJoin } part = Part::kWhole;
 };
 
+/// What a commit did. The switch is carried out whatever a task's fault on the way.
+struct CommitOutcome {
+  /// The instant the joining tasks are released from (executive clock): the one asked for, or
+  /// later when a leaving task had already run a release at or after it (a commit posted late),
+  /// so that no release is run by two producers. A kLeave part gives what its join part must use.
+  std::int64_t joins_from_ns = -1;
+  Result<void> fault;  // the first task that failed to turn off or on, if any
+};
+
 /// What the subsystem interface asks the executive to serve while it runs.
 struct ServiceHooks {
   Doorbell* requests = nullptr;          // rings when a module asks for a switch (rung to stop, too)
@@ -109,7 +118,7 @@ class Executive {
   /// A switch's commit at one cycle boundary of the fastest task involved: the leaving tasks off
   /// after their last release before it, the joining ones on and released from it, the others
   /// untouched; then the plan of `commit.target`.
-  virtual Result<void> commit_switch(const SwitchCommit& commit) = 0;
+  virtual CommitOutcome commit_switch(const SwitchCommit& commit) = 0;
   /// reinit() of task `task` between two of its cycles.
   virtual Result<void> reinit(std::size_t task) = 0;
   /// Lets the subsystem run for `ns`: simulated time on the virtual clock (the requests of

@@ -168,9 +168,10 @@ Result<void> ModuleProcess::command(const ProcessCommand& command) {
   return await_answer();
 }
 
-Result<void> ModuleProcess::await_answer() {
+Result<void> ModuleProcess::await_answer(std::int64_t* value) {
   ProcessReply reply;
   if (auto r = await_reply(reply, kReplyTimeoutMs); !r) return r;
+  if (value != nullptr) *value = reply.value;
   return reply.result();
 }
 

@@ -49,7 +49,8 @@ class ModuleProcess {
   /// command() in two halves, so that several processes carry out one command at once: post()
   /// sends, await_answer() waits for its reply (or the end). A failed post needs no await.
   Result<void> post(const ProcessCommand& command);
-  Result<void> await_answer();
+  /// `value`, when given, receives the reply's value (ProcessReply::value), even with an error.
+  Result<void> await_answer(std::int64_t* value = nullptr);
   /// Whether the process is running: started, and not seen to end.
   [[nodiscard]] bool running() const noexcept { return state_.load(std::memory_order_acquire) == State::kRunning; }
   /// Whether its end has been seen but not yet reaped.

@@ -235,12 +235,13 @@ Result<void> ProcessExecutive::turn_on_together(const std::vector<std::size_t>& 
   return first;
 }
 
-Result<void> ProcessExecutive::commit_switch(const SwitchCommit& commit) {
+CommitOutcome ProcessExecutive::commit_switch(const SwitchCommit& commit) {
   // One instant for every executive, on the one grid they share: each turns its leaving tasks off
   // after their last release before it, and its joining tasks on for their first release from
   // it. Every leaving task, in every process, is off before any joining one turns on: one writer
-  // per variable at any time, as within one process (docs/processes.md).
-  const std::int64_t at_ns = local_->next_commit_ns(commit);
+  // per variable at any time, as within one process (docs/processes.md). A leave posted late may
+  // find its task has run the instant's release: the join part then starts after the last such.
+  std::int64_t at_ns = local_->next_commit_ns(commit);
   SwitchCommit local;
   std::vector<SwitchCommit> remote(processes_.size());
   for (const std::size_t i : commit.leaving)
@@ -257,9 +258,9 @@ Result<void> ProcessExecutive::commit_switch(const SwitchCommit& commit) {
   // to a worker while the switch is under way.
   std::vector<std::unique_lock<std::mutex>> locks;
   for (auto& p : processes_) locks.emplace_back(p->mutex);
-  Result<void> first;
-  const auto keep = [&first](const Result<void>& r) {
-    if (!r && first) first = r;
+  CommitOutcome outcome;
+  const auto keep = [&outcome](const Result<void>& r) {
+    if (!r && outcome.fault) outcome.fault = r;
   };
   for (const SwitchCommit::Part part : {SwitchCommit::Part::kLeave, SwitchCommit::Part::kJoin}) {
     std::vector<bool> posted(processes_.size(), false);
@@ -293,14 +294,20 @@ Result<void> ProcessExecutive::commit_switch(const SwitchCommit& commit) {
     here.target = commit.target;
     here.at_ns = at_ns;
     here.part = part;
-    keep(local_->commit_switch(here));
+    const CommitOutcome mine = local_->commit_switch(here);
+    keep(mine.fault);
+    std::int64_t joins_from_ns = mine.joins_from_ns;
     for (std::size_t k = 0; k < processes_.size(); ++k) {
       if (!posted[k]) continue;
-      keep(processes_[k]->await_answer());
+      std::int64_t theirs = -1;
+      keep(processes_[k]->await_answer(&theirs));
+      joins_from_ns = std::max(joins_from_ns, theirs);
       if (processes_[k]->death_seen()) handle_end(*processes_[k]);
     }
+    at_ns = std::max(at_ns, joins_from_ns);
   }
-  return first;
+  outcome.joins_from_ns = at_ns;
+  return outcome;
 }
 
 Result<void> ProcessExecutive::reinit(std::size_t task) {

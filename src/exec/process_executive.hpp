@@ -38,7 +38,7 @@ class ProcessExecutive final : public Executive {
   [[nodiscard]] int cpu_of(std::size_t task) const override { return local_->cpu_of(task); }
   Result<void> signal(std::size_t task, Signal signal) override;
   Result<void> turn_on_together(const std::vector<std::size_t>& tasks) override;
-  Result<void> commit_switch(const SwitchCommit& commit) override;
+  CommitOutcome commit_switch(const SwitchCommit& commit) override;
   Result<void> reinit(std::size_t task) override;
   void run_for(std::int64_t ns) override { local_->run_for(ns); }
   void serve(ServiceHooks hooks) override { local_->serve(std::move(hooks)); }

@@ -41,9 +41,11 @@ struct ProcessReply {
   std::uint32_t ok = 1;
   Errc code = Errc::kSystem;
   std::array<char, 512> message{};
+  std::int64_t value = -1;  // kCommit: CommitOutcome::joins_from_ns
 
-  static ProcessReply from(const Result<void>& r) {
+  static ProcessReply from(const Result<void>& r, std::int64_t value = -1) {
     ProcessReply reply;
+    reply.value = value;
     if (r) return reply;
     reply.ok = 0;
     reply.code = r.error().code;

@@ -393,12 +393,12 @@ std::int64_t RealExecutive::next_commit_ns(const SwitchCommit& commit) const {
   return shortest > 0 ? release_policy::next_boundary_after(now + kCommitMarginNs, shortest) : now;
 }
 
-Result<void> RealExecutive::commit_switch(const SwitchCommit& commit) {
+CommitOutcome RealExecutive::commit_switch(const SwitchCommit& commit) {
   const std::vector<std::size_t>& leaving = commit.leaving;
   const std::vector<std::size_t>& joining = commit.joining;
   const bool leave_part = commit.part != SwitchCommit::Part::kJoin;
   const bool join_part = commit.part != SwitchCommit::Part::kLeave;
-  Result<void> r;
+  CommitOutcome outcome;
   {
     std::lock_guard<std::mutex> lock(control_mutex_);
     const std::int64_t commit_ns = commit.at_ns >= 0 ? commit.at_ns : next_commit_ns(commit);
@@ -407,40 +407,55 @@ Result<void> RealExecutive::commit_switch(const SwitchCommit& commit) {
     // writer per variable at any time.
     // Successors of the joining tasks must wait for them from the commit's release on, even if
     // the commit runs late: tell them before anything changes.
-    if (leave_part) {
-      for (const std::size_t i : joining) {
-        Worker& w = *workers_[i];
-        if (w.task->periodic())
-          w.precedence.joining_k.store(release_policy::first_release_index(commit_ns, w.task->period_ns()),
-                                       std::memory_order_release);  // release: pairs with successors' acquire
-      }
-    }
+    if (leave_part) publish_joins(joining, commit_ns);
     // The commit is timed to a cycle boundary: the control thread runs it at a real-time priority
     // above the tasks', so that it is not the one that comes late.
     const ScopedPriority urgent(realtime_, kCommitPriority);
+    outcome.joins_from_ns = commit_ns;
     if (leave_part) {
       const std::vector<Mail> leave(leaving.size(), Mail{MailKind::kLeaveAt, Signal::kOff, epoch_ns_ + commit_ns});
-      r = post_all(leaving, leave);
+      outcome.fault = post_all(leaving, leave);
+      // Posted late (the control thread held up past the commit's instant), a leave finds its task
+      // has run the commit's release, or more: the joining tasks start after the last of those.
+      for (const std::size_t i : leaving) {
+        const std::int64_t last = workers_[i]->mailbox.last_release_ns;  // published by the answer
+        if (last != Worker::kNoRelease) outcome.joins_from_ns = std::max(outcome.joins_from_ns, last + 1);
+      }
     }
     if (join_part) {
       // Each joining task turns on right before its first release from the commit on, on its own
       // thread: not earlier, since on() publishes outputs a consumer may still be reading the
       // leaving producer's last value of. Its first release is the commit's even if the commit ran
-      // late (then it runs late): the leaving task ran none from there, and no release may go
-      // unproduced. They are all posted at once and answer as each turns on.
+      // late (then it runs late) unless a leaving task ran that one: no release may go unproduced,
+      // nor be produced twice. They are all posted at once and answer as each turns on.
+      if (outcome.joins_from_ns != commit_ns || !leave_part) publish_joins(joining, outcome.joins_from_ns);
       std::vector<Mail> join;
       for (const std::size_t i : joining) {
         const Worker& w = *workers_[i];
         const std::int64_t p = w.task->periodic() ? w.task->period_ns() : 1;
-        join.push_back(Mail{MailKind::kOnAt, Signal::kOn, release_policy::first_release_index(commit_ns, p)});
+        join.push_back(Mail{MailKind::kOnAt, Signal::kOn, release_policy::first_release_index(outcome.joins_from_ns, p)});
       }
-      if (auto on = post_all(joining, join); r && !on) r = on;
+      if (auto on = post_all(joining, join); outcome.fault && !on) outcome.fault = on;
       for (const std::size_t i : joining)
         workers_[i]->precedence.joining_k.store(-1, std::memory_order_release);  // scheduled says it now
     }
   }
   if (join_part) set_plan(make_schedule_plan(subsystem_, order_, subsystem_cpus(*subsystem_.spec), commit.target));
-  return r;
+  return outcome;
+}
+
+void RealExecutive::publish_joins(const std::vector<std::size_t>& joining, std::int64_t from_ns) {
+  for (const std::size_t i : joining) {
+    Worker& w = *workers_[i];
+    if (!w.task->periodic()) continue;
+    w.precedence.joining_k.store(release_policy::first_release_index(from_ns, w.task->period_ns()),
+                                 std::memory_order_release);  // release: pairs with successors' acquire
+    // A successor asleep on it for a release it no longer joins at must look again, not sleep to
+    // its bound: the leaving producer ran that release. (One just going to sleep may still sleep
+    // to its bound: a bounded wait, and only when a commit was posted late.)
+    if (w.precedence.waiters.load(std::memory_order_seq_cst) != 0)  // seq_cst: as in Worker::act
+      detail::futex_wake_all(w.precedence.completed);
+  }
 }
 
 void RealExecutive::set_plan(SchedulePlan plan) {

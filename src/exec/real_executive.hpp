@@ -42,7 +42,7 @@ class RealExecutive final : public Executive {
   [[nodiscard]] int cpu_of(std::size_t task) const override { return cpus_[task]; }
   Result<void> signal(std::size_t index, Signal sig) override;
   Result<void> turn_on_together(const std::vector<std::size_t>& indices) override;
-  Result<void> commit_switch(const SwitchCommit& commit) override;
+  CommitOutcome commit_switch(const SwitchCommit& commit) override;
   /// The instant a switch posted now would commit at (SwitchCommit::at_ns). Not real-time safe.
   [[nodiscard]] std::int64_t next_commit_ns(const SwitchCommit& commit) const;
   Result<void> reinit(std::size_t index) override;
@@ -76,6 +76,8 @@ class RealExecutive final : public Executive {
   static Result<void> post(Worker& w, Mail mail);
   /// Posts `mail` to several tasks' threads at once, then waits for every answer.
   Result<void> post_all(const std::vector<std::size_t>& indices, const std::vector<Mail>& mails);
+  /// Tells the successors of the joining tasks the release each joins at: its first from `from_ns`.
+  void publish_joins(const std::vector<std::size_t>& joining, std::int64_t from_ns);
   /// Posts only; returns the sequence number of the answer to wait for.
   static std::uint32_t send(Worker& w, const Mail& mail);
   static Result<void> await(Worker& w, std::uint32_t seq);

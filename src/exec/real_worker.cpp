@@ -147,12 +147,16 @@ void Worker::leave() {
   const std::uint32_t seq = schedule.leave_seq;
   schedule.leave_at = -1;
   schedule.leave_seq = 0;
+  mailbox.last_release_ns = task->state() == TaskState::kOn && task->periodic() && schedule.last_run >= 0
+                                ? schedule.last_run * task->period_ns()
+                                : kNoRelease;
   mailbox.reply = task->state() == TaskState::kOn ? task->apply(Signal::kOff, exec->now_ns()) : Result<void>{};
   schedule.held = false;
   reply_to(seq);
 }
 
 void Worker::on_turned_on() noexcept {
+  schedule.last_run = -1;
   wake.trigger_var.store(task->trigger_var(), std::memory_order_relaxed);  // producers read it on its own
   wake.update_pending.store(false, std::memory_order_relaxed);
   if (task->spec().server) server.turn_on(task->spec().server->budget_ns);
@@ -221,11 +225,16 @@ void Worker::act() {
     // A successor asleep on one of the releases skipped must look again now, not at its bound.
     if (precedence.waiters.load(std::memory_order_seq_cst) != 0) detail::futex_wake_all(precedence.completed);
     if (task->state() != TaskState::kOn || now < late.next_release) return;
+    if (schedule.leave_seq != 0 && epoch + schedule.k * period >= schedule.leave_at) {
+      leave();  // the releases skipped reached the commit: the joining task runs this one
+      return;
+    }
   }
   const std::int64_t release_abs = epoch + schedule.k * period;
   if (dispatcher != nullptr) publish_job(release_abs);
   wait_for_predecessors(schedule.k, release_abs);
   (void)run_job(release_abs);
+  schedule.last_run = schedule.k;
   // seq_cst store, then seq_cst load of `waiters`: with the successor's seq_cst increment and
   // re-check this is Dekker's pattern, so either it sees our store or we see it waiting.
   precedence.completed.store(static_cast<std::uint32_t>(schedule.k + 1), std::memory_order_seq_cst);

@@ -66,6 +66,7 @@ struct Mail {
 
 struct Worker {
   static constexpr std::int64_t kNever = std::numeric_limits<std::int64_t>::max();
+  static constexpr std::int64_t kNoRelease = std::numeric_limits<std::int64_t>::min();
 
   // Fixed at construction (before any thread starts).
   RealExecutive* exec = nullptr;
@@ -86,6 +87,9 @@ struct Worker {
     Mail mail;
     alignas(64) std::atomic<std::uint32_t> done_seq{0};  // written by the task's thread
     Result<void> reply;
+    // kLeaveAt's answer beside `reply`: the last release it ran (executive clock), kNoRelease if
+    // none. A commit posted late may find it has run the commit's release already.
+    std::int64_t last_release_ns = kNoRelease;
     std::uint32_t seen = 0;  // the last mail handled; the task's thread's
   } mailbox;
 
@@ -124,6 +128,7 @@ struct Worker {
   /// it is in the middle of.
   struct Schedule {
     std::int64_t k = 0;           // periodic: index of its next release on the grid
+    std::int64_t last_run = -1;   // periodic: index of the last release it ran since it turned on
     bool held = false;            // ON, but waiting for kJoin before its first release
     std::int64_t leave_at = -1;   // absolute time: turn off before the first release at or after it
     std::uint32_t leave_seq = 0;  // the kLeaveAt request to answer once off (0: none)

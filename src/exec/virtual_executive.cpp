@@ -306,18 +306,20 @@ Result<void> VirtualExecutive::turn_on_together(const std::vector<std::size_t>& 
   return {};
 }
 
-Result<void> VirtualExecutive::commit_switch(const SwitchCommit& commit) {
+CommitOutcome VirtualExecutive::commit_switch(const SwitchCommit& commit) {
   // Creating tasks takes no simulated time, but a switch that must create them is one that takes
   // longer than a cycle: the old configuration runs on, flag raised, until the next boundary of
   // the fastest task involved.
   const std::int64_t shortest = shortest_period(tasks_, commit);
   if (commit.slow && shortest > 0) (void)run_until(release_policy::next_boundary_after(now_ns_, shortest));
-  Result<void> committed;
+  // Simulated time never runs late: the joining tasks are released from now, the boundary.
+  CommitOutcome outcome;
+  outcome.joins_from_ns = now_ns_;
   for (const std::size_t i : commit.leaving) (void)signal(i, Signal::kOff);
   for (const std::size_t i : commit.joining)
-    if (auto r = signal(i, Signal::kOn); !r && committed) committed = r;
+    if (auto r = signal(i, Signal::kOn); !r && outcome.fault) outcome.fault = r;
   plan_ = make_schedule_plan(subsystem_, order_, subsystem_cpus(*subsystem_.spec), commit.target);
-  return committed;
+  return outcome;
 }
 
 void VirtualExecutive::shutdown() {

@@ -39,7 +39,7 @@ class VirtualExecutive final : public Executive {
   Result<void> signal(std::size_t task, Signal signal) override;
   /// The simulated clock does not move while they turn on: one after the other is together.
   Result<void> turn_on_together(const std::vector<std::size_t>& tasks) override;
-  Result<void> commit_switch(const SwitchCommit& commit) override;
+  CommitOutcome commit_switch(const SwitchCommit& commit) override;
   Result<void> reinit(std::size_t task) override;
   void run_for(std::int64_t ns) override;
   void serve(ServiceHooks hooks) override { hooks_ = std::move(hooks); }

@@ -167,7 +167,7 @@ Result<SwitchRecord> Reconfiguration::switch_to(std::string_view name, std::stri
   // Phase 2, commit at one cycle boundary; then consumers of a constant whose value changed read
   // it anew before their next cycle.
   const Result<void> committed =
-      executive_.commit_switch(SwitchCommit{plan->leaving, plan->joining, record.flag_raised, target->tasks});
+      executive_.commit_switch(SwitchCommit{plan->leaving, plan->joining, record.flag_raised, target->tasks}).fault;
   record.committed_ns = executive_.now_ns();
   configuration_ = target->name;
   record.reinit = reinit_readers(changed_values(before, read_values(table_, consts)), plan->joining);

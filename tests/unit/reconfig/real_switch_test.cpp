@@ -8,6 +8,7 @@
 
 #include "chimera/config/loader.hpp"
 #include "chimera/control/subsystem.hpp"
+#include "control/subsystem_test_access.hpp"
 #include "support/reconfig_modules.hpp"
 #include "support/run_subsystem.hpp"
 
@@ -66,6 +67,40 @@ TEST(RealSwitch, SwitchesBackAndForthOnRealThreads) {
   for (const auto& [latency, count] : robot.latency_histogram)
     if (latency >= 2 * kMs) late += count;
   EXPECT_LE(s->get("stale")->at(0), static_cast<double>(robot.order_timeouts + late));
+}
+
+// A commit posted late: the control thread held up past the commit's instant (a VM stall, a
+// preemption) finds the leaving producer has already run that release, and more. Made certain
+// here by posting commits whose instant is three periods past. The joining producer must start
+// after the leaving one's last release, or the robot's releases would each be produced twice.
+TEST(RealSwitch, ACommitPostedLateRunsNoReleaseTwice) {
+  auto s = start(kTwoProducers);
+  ASSERT_TRUE(s);
+  ASSERT_TRUE(s->signal("b", Signal::kSpawn).ok());  // created, OFF: the switch's first phase
+  Executive& executive = SubsystemTestAccess::executive(*s);
+  constexpr std::int64_t kPeriod = 2 * kMs;
+  constexpr std::size_t kA = 0;  // the file's order
+  constexpr std::size_t kB = 1;
+  for (int i = 0; i < 10; ++i) {
+    s->run_for(10 * kMs);
+    const bool to_b = i % 2 == 0;
+    SwitchCommit late;
+    late.leaving = {to_b ? kA : kB};
+    late.joining = {to_b ? kB : kA};
+    late.target = {to_b ? "b" : "a", "robot"};
+    late.at_ns = (executive.now_ns() / kPeriod - 3) * kPeriod;
+    const CommitOutcome outcome = executive.commit_switch(late);
+    ASSERT_TRUE(outcome.fault.ok()) << outcome.fault.error().message;
+    EXPECT_GE(outcome.joins_from_ns, late.at_ns);
+  }
+  s->run_for(10 * kMs);
+  ASSERT_TRUE(s->signal("robot", Signal::kOff).ok());
+  ASSERT_TRUE(s->signal("a", Signal::kOff).ok());  // the tenth commit turned a back on
+  const auto robot = stats_of(*s, "robot");
+  EXPECT_GT(robot.cycles, 30u);
+  const std::uint64_t produced = stats_of(*s, "a").cycles + stats_of(*s, "b").cycles;
+  EXPECT_LE(robot.cycles, produced) << "a release no producer ran";
+  EXPECT_LE(produced, robot.cycles + 1) << "releases two producers ran";
 }
 
 TEST(RealSwitch, TheRequestServiceCarriesOutWhatATaskAsksFor) {
