@@ -140,8 +140,8 @@ struct Fig4 {
 
 void BM_PidPullInVarsNothingNew(benchmark::State& state) {
   Fig4 f;
-  f.generator.push_out_vars();
-  f.robot.push_out_vars();
+  f.generator.push_out_vars(0);
+  f.robot.push_out_vars(0);
   f.pid.pull_in_vars();
   for (auto _ : state) {
     f.pid.pull_in_vars();  // four version checks, no copy
@@ -152,7 +152,7 @@ void BM_PidPullInVarsNothingNew(benchmark::State& state) {
 void BM_PidPushOutVars(benchmark::State& state) {
   Fig4 f;
   for (auto _ : state) {
-    f.pid.push_out_vars();  // tau_r
+    f.pid.push_out_vars(0);  // tau_r
     benchmark::ClobberMemory();
   }
 }
@@ -162,10 +162,10 @@ void BM_Fig4CycleTransfers(benchmark::State& state) {
   for (auto _ : state) {
     // One period of all three tasks: 4 writes by the producers, 4 new reads and 1 write by the
     // PID, 1 new read by the robot.
-    f.generator.push_out_vars();
-    f.robot.push_out_vars();
+    f.generator.push_out_vars(0);
+    f.robot.push_out_vars(0);
     f.pid.pull_in_vars();
-    f.pid.push_out_vars();
+    f.pid.push_out_vars(0);
     f.robot.pull_in_vars();
     benchmark::ClobberMemory();
   }

@@ -33,6 +33,11 @@ struct RunArgs {
   bool rt_check = false;                  // count allocations in the tasks' real-time methods
   std::optional<std::string> listen;      // --listen [ADDR:]PORT: the network control API
   std::optional<std::string> token_file;  // --token-file FILE: its tokens
+  // The flight recorder (docs/flight-recorder.md): --record DURATION of history (0: off), dumps
+  // below --dump-dir (when a task enters ERROR, on `dump`), and one more at exit with --dump-at-exit.
+  std::int64_t record_ns = 10'000'000'000;
+  std::optional<std::string> dump_dir;
+  bool dump_at_exit = false;
 };
 /// `chimera run FILE ...`, and `chimera serve` (file empty: an empty subsystem); returns the exit code.
 int run_command(const RunArgs& args);

@@ -72,6 +72,20 @@ int run_main(int argc, char** argv) {
   auto* run_stats_opt = run_cmd->add_option("--stats-json", run_stats, "write per-task timing figures here at exit");
   run_cmd->add_flag("--rt-check", run.rt_check,
                     "count allocations inside each task's on/cycle/off/sync (rt violations in the timing table)");
+  std::string run_record = "10s";
+  std::string run_dump_dir;
+  run_cmd
+      ->add_option("--record", run_record,
+                   "flight recorder: keep this long of every variable and task's timing in memory (off: none)")
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            return text == "off" ? std::string() : duration_validator()(text);
+          },
+          "DURATION|off"))
+      ->capture_default_str();
+  auto* run_dump_dir_opt = run_cmd->add_option(
+      "--dump-dir", run_dump_dir, "where the recorder's dumps go (default: chimera-dumps below $CHIMERA_LOG_DIR or .)");
+  run_cmd->add_flag("--dump-at-exit", run.dump_at_exit, "write the recorder's last seconds once more as the run ends");
   chimera::cli::add_listen_options(*run_cmd, run);
   chimera::cli::RunArgs serve;
   auto* serve_cmd = chimera::cli::add_serve_command(app, serve);
@@ -124,6 +138,8 @@ int run_main(int argc, char** argv) {
     if (run_config_opt->count() > 0) run.config = run_config;
     if (run_for_opt->count() > 0) run.for_ns = *chimera::parse_duration_ns(run_for);
     if (run_stats_opt->count() > 0) run.stats_json = run_stats;
+    run.record_ns = run_record == "off" ? 0 : *chimera::parse_duration_ns(run_record);
+    if (run_dump_dir_opt->count() > 0) run.dump_dir = run_dump_dir;
     run.clock = run_clock == "virtual" ? chimera::ClockKind::kVirtual : chimera::ClockKind::kReal;
     return chimera::cli::run_command(run);
   }

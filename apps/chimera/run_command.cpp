@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -164,6 +165,15 @@ class Session {
   bool interactive_;
 };
 
+// The flight recorder's dumps: --dump-dir, else chimera-dumps below $CHIMERA_LOG_DIR (where the
+// data loggers write) or the working directory.
+std::string dump_directory(const RunArgs& args) {
+  if (args.dump_dir) return *args.dump_dir;
+  // NOLINTNEXTLINE(concurrency-mt-unsafe): read before any thread of the run starts
+  const char* logs = std::getenv("CHIMERA_LOG_DIR");
+  return logs != nullptr && *logs != '\0' ? std::string(logs) + "/chimera-dumps" : std::string("chimera-dumps");
+}
+
 }  // namespace
 
 int run_command(const RunArgs& args) {
@@ -186,6 +196,8 @@ int run_command(const RunArgs& args) {
   options.clock = args.clock;
   options.configuration = args.config;
   options.rt_check = args.rt_check;
+  options.record_seconds = static_cast<double>(args.record_ns) / 1e9;
+  options.error_dump_dir = dump_directory(args);
   if (args.rt_check && !kRtCheckAllocator)
     fmt::print(stderr, "--rt-check: this build's allocator belongs to a sanitizer; nothing will be counted\n");
   auto created = Subsystem::create(*spec, registry, options);
@@ -236,6 +248,15 @@ int run_command(const RunArgs& args) {
     remote.reset();  // the bridge stops writing imports before the tasks stop
   }
 
+  std::optional<std::string> exit_dump_failure;
+  if (args.dump_at_exit) {
+    if (auto written = subsystem.dump(fmt::format("{}/{}-exit", options.error_dump_dir, spec->name), "the run's end");
+        written)
+      err(fmt::format("flight recorder: the last {:.3g} s written to {}/\n", subsystem.recorded_seconds(), *written));
+    else
+      exit_dump_failure = written.error().message;
+  }
+
   // The figures as they stood while the tasks ran; stopping turns every task NOT-CREATED.
   const auto tasks = subsystem.snapshot();
   const std::uint64_t switches = subsystem.switches().size();
@@ -247,6 +268,10 @@ int run_command(const RunArgs& args) {
   // Exit 1 says why in the run's last line: the hard tasks that failed, the modules that could
   // not release their resources cleanly (a data logger's lost rows), figures that were not written.
   std::vector<std::string> faults = subsystem.faults();
+  if (exit_dump_failure) {
+    err(*exit_dump_failure + "\n");
+    faults.push_back(*exit_dump_failure);
+  }
   if (args.stats_json) {
     if (auto written = write_stats_json(*args.stats_json, tasks, args.clock, switches, args.rt_check); !written) {
       err(written.error().message + "\n");

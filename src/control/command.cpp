@@ -51,6 +51,8 @@ constexpr std::array kVerbs{
     VerbSpec{Verb::kRemove, "remove", 1, 1, "remove TASK", "remove a task that no configuration uses"},
     VerbSpec{Verb::kSave, "save", 0, 1, "save [FILE]",
              "the subsystem as a file that chimera verify accepts (to FILE, or as the reply)"},
+    VerbSpec{Verb::kDump, "dump", 0, 1, "dump [DIR]",
+             "write the flight recorder's last seconds of every variable and task's timing (to DIR, or a new one)"},
 };
 
 constexpr std::array<VerbHelp, kVerbs.size()> make_help() {

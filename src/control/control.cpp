@@ -92,6 +92,11 @@ Reply Control::execute(const Command& command) {
       case Verb::kVerify:
       case Verb::kRemove:
       case Verb::kSave: return assemble(command);
+      case Verb::kDump: {
+        auto written = subsystem_.dump(command.args.empty() ? std::string() : command.args[0], "the operator's dump");
+        if (!written) return refused(written.error().message);
+        return said(fmt::format("the last {:.3g} s written to {}/\n", subsystem_.recorded_seconds(), *written));
+      }
     }
   } catch (const std::exception& e) {
     return refused(fmt::format("{}: internal error: {}", verb_name(command.verb), e.what()));

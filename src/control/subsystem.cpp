@@ -119,6 +119,10 @@ Result<void> Subsystem::Impl::build_runtime(const std::string& configuration, st
     m.removed.assign(m.tasks->size(), false);
   }
   for (Task* t : m.tasks->pointers()) t->set_rt_check(m.options.rt_check);
+  m.recorder = m.options.record_seconds > 0
+                   ? std::make_unique<FlightRecorder>(resolved, *m.table, *m.tasks, m.options.record_seconds)
+                   : nullptr;
+  m.dumped_failure.assign(m.tasks->size(), 0);
   ExecutiveSetup setup;
   setup.clock = m.options.clock;
   setup.realtime_priorities = m.options.realtime_priorities;
@@ -217,6 +221,7 @@ void Subsystem::run_for(std::int64_t ns) {
   Impl& m = *impl_;
   if (m.stopped) return;
   m.executive->run_for(ns);
+  if (m.recorder && !m.options.error_dump_dir.empty()) m.dump_new_errors();
 }
 
 Result<SwitchRecord> Subsystem::switch_to(std::string_view name, std::string_view cause) {

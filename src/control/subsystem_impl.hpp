@@ -13,6 +13,7 @@
 #include "chimera/control/subsystem.hpp"
 #include "chimera/svt/global_table.hpp"
 #include "exec/event_log.hpp"
+#include "flight_recorder.hpp"
 #include "exec/executive.hpp"
 #include "exec/task_block.hpp"
 #include "exec/task_set.hpp"
@@ -33,6 +34,8 @@ struct Subsystem::Impl {
   std::unique_ptr<SubsystemRequestBoard> requests;
   std::unique_ptr<TaskBlock> block;  // module processes' tasks' shared slots (docs/processes.md); null: none
   std::unique_ptr<TaskSet> tasks;
+  std::unique_ptr<FlightRecorder> recorder;  // the tasks write into it; null: none kept
+  std::vector<std::uint64_t> dumped_failure;  // per task, the failure its ERROR dump was for; run_for's thread only
   std::unique_ptr<EventLog> events;
   std::unique_ptr<Executive> executive;
   std::unique_ptr<Reconfiguration> reconfiguration;
@@ -81,6 +84,11 @@ struct Subsystem::Impl {
     const auto i = tasks->index_of(name);
     return i && !is_removed(*i) ? i : std::nullopt;
   }
+  /// The flight recorder's dump for each task that entered ERROR since the last call (each failure
+  /// once), into options.error_dump_dir, announced by an event. From run_for's thread.
+  void dump_new_errors();
+  /// Each task's state and last error, for a dump's summary.
+  [[nodiscard]] std::vector<std::string> summary_lines() const;
   /// The fault lines of the current runtime's tasks (faults() adds the earlier ones).
   [[nodiscard]] std::vector<std::string> runtime_faults() const;
   /// Resolves `spec`, creates the table and the runtime on it, with `configuration` on and the

@@ -64,6 +64,13 @@ void Task::note_rt_allocation() noexcept {
                  "() allocated on the real-time path (--rt-check)");
 }
 
+void Task::keep_history(HistoryRings* rings, std::int32_t timing_ring, std::span<const std::int32_t> ring_of_var) noexcept {
+  history_ = timing_ring >= 0 ? rings : nullptr;
+  timing_ring_ = timing_ring;
+  ring_of_var_ = ring_of_var;
+  if (local_) local_->keep_history(history_, ring_of_var_);
+}
+
 Status Task::dispatch(Hook hook) noexcept {
   try {
     switch (hook) {
@@ -91,7 +98,7 @@ Status Task::dispatch(Hook hook) noexcept {
 Status Task::call(Hook hook) noexcept {
   local_->pull_in_vars();
   const Status s = call_raw(hook);
-  if (hook != Hook::kKill) local_->push_out_vars();  // a killed module has nothing left to publish
+  if (hook != Hook::kKill) local_->push_out_vars(timing_.release_ns);  // a killed module has nothing left to publish
   return s;
 }
 
@@ -137,7 +144,7 @@ std::int64_t Task::begin_job(std::int64_t release_ns, std::int64_t start_ns) noe
     s = call_raw(Hook::kCycle);
   }
   if (!s.is_ok()) {
-    local_->push_out_vars();  // what the failed method wrote is published, as after any method
+    local_->push_out_vars(release_ns);  // what the failed method wrote is published, as after any method
     job_.failed = true;
     (void)recover(hook, s, start_ns);
   }
@@ -147,7 +154,7 @@ std::int64_t Task::begin_job(std::int64_t release_ns, std::int64_t start_ns) noe
 std::int64_t Task::end_job(std::int64_t end_ns, std::int64_t used_ns) noexcept {
   if (!job_.open) return 0;
   job_.open = false;
-  if (!job_.failed && local_) local_->push_out_vars();
+  if (!job_.failed && local_) local_->push_out_vars(job_.release_ns);
   const std::int64_t host_ns = exec_clock_now() - job_.exec_start;
   // On the virtual clock the job took its simulated time, which the statistics record as its
   // execution time (the time the schedule was made of); the host's time is kept apart.
@@ -156,6 +163,12 @@ std::int64_t Task::end_job(std::int64_t end_ns, std::int64_t used_ns) noexcept {
   const bool missed = end_ns > absolute_deadline(job_.release_ns);
   const bool overrun = spec_.wcet_ns.has_value() && used_ns > *spec_.wcet_ns;
   shared_->stats.record_cycle(job_.start_ns - job_.release_ns, used_ns, end_ns - job_.release_ns, missed, overrun);
+  if (history_ != nullptr) {
+    const CycleRecord record{job_.start_ns - job_.release_ns, used_ns, end_ns - job_.release_ns,
+                             (missed ? CycleRecord::kMissed : 0) | (overrun ? CycleRecord::kOverrun : 0) |
+                                 (job_.failed ? CycleRecord::kFailed : 0)};
+    history_->write(static_cast<std::size_t>(timing_ring_), job_.release_ns, &record);
+  }
   if (simulated) shared_->stats.record_host_exec(host_ns);
   ++timing_.cycle;
   if ((missed || overrun) && hard() && state() == TaskState::kOn)
@@ -188,6 +201,10 @@ bool Task::reinit(std::int64_t now_ns) noexcept {
 void Task::skip_releases(std::uint64_t n, std::int64_t now_ns) noexcept {
   if (n == 0) return;
   shared_->stats.record_skipped(n);
+  if (history_ != nullptr) {
+    const CycleRecord record{static_cast<std::int64_t>(n), 0, 0, CycleRecord::kSkipped};
+    history_->write(static_cast<std::size_t>(timing_ring_), now_ns, &record);
+  }
   if (hard() && state() == TaskState::kOn) timing_fault(Fault::kDeadlineMissed, now_ns);
 }
 
@@ -248,6 +265,7 @@ Result<void> Task::spawn(std::int64_t now_ns) {
   auto local = LocalTable::create(table_, resolved_.bindings);
   if (!local) return make_error(Errc::kModuleFault, fmt::format("{}: {}", spec_.name, local.error().message));
   local_ = std::make_unique<LocalTable>(std::move(*local));
+  local_->keep_history(history_, ring_of_var_);
   // Out-consts start as the values the module declared (what verification already used); a
   // module may still write them in init.
   for (const auto& port : resolved_.decls.ports()) {
@@ -286,7 +304,7 @@ Result<void> Task::spawn(std::int64_t now_ns) {
   // writer per variable at any time. Its on() publishes them when it joins.
   if (publish_at_spawn_) {
     local_->push_out_consts();
-    local_->push_out_vars();
+    local_->push_out_vars(now_ns);
   }
   if (!periodic() && !trigger_.any())
     shared_->events.push(now_ns, "aperiodic, and its module declared no trigger in init: it will never cycle", nullptr);

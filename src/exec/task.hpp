@@ -16,11 +16,13 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "chimera/config/verify.hpp"
+#include "chimera/core/history_rings.hpp"
 #include "chimera/core/result.hpp"
 #include "chimera/exec/stats.hpp"
 #include "chimera/lifecycle/state.hpp"
@@ -31,6 +33,20 @@
 #include "task_shared.hpp"
 
 namespace chimera {
+
+/// One cycle as the flight recorder keeps it (docs/flight-recorder.md), stamped with its release
+/// time; or, with kSkipped, releases that did not run.
+struct CycleRecord {
+  static constexpr std::uint64_t kMissed = 1;    // ended after its deadline
+  static constexpr std::uint64_t kOverrun = 2;   // ran longer than its wcet budget
+  static constexpr std::uint64_t kFailed = 4;    // its method failed (the error path ran)
+  static constexpr std::uint64_t kSkipped = 8;   // not a cycle: `latency_ns` releases skipped (late: skip)
+  std::int64_t latency_ns = 0;   // release to start
+  std::int64_t exec_ns = 0;      // execution time, on the clock the statistics use
+  std::int64_t response_ns = 0;  // release to end
+  std::uint64_t flags = 0;
+};
+static_assert(sizeof(CycleRecord) == 4 * sizeof(std::uint64_t), "the recorder reads a CycleRecord as four words");
 
 class Task {
  public:
@@ -111,6 +127,10 @@ class Task {
   /// An allocation while one of its real-time methods ran on this thread (the allocator hook
   /// calls it): counted; the first also tells the operator which method. Real-time safe.
   void note_rt_allocation() noexcept;
+  /// The flight recorder (docs/flight-recorder.md): each cycle's CycleRecord goes to ring
+  /// `timing_ring` of `rings`, and each output variable v's value to ring `ring_of_var[v]` (-1:
+  /// none). The rings and the span outlive the task. Before spawn; not real-time safe.
+  void keep_history(HistoryRings* rings, std::int32_t timing_ring, std::span<const std::int32_t> ring_of_var) noexcept;
   /// Where its module's switch requests go, and its index there (set before spawn).
   void set_request_board(RequestBoard* board, int index) noexcept { services_ = {board, index}; }
 
@@ -172,6 +192,9 @@ class Task {
   bool virtual_clock_ = false;
   bool publish_at_spawn_ = true;
   bool rt_check_ = false;
+  HistoryRings* history_ = nullptr;  // the flight recorder's rings, or none
+  std::int32_t timing_ring_ = -1;
+  std::span<const std::int32_t> ring_of_var_;
   Hook rt_hook_ = Hook::kCycle;  // the real-time method running under --rt-check, for the event
   struct Job {
     bool open = false;

@@ -44,7 +44,7 @@ Result<LocalTable> LocalTable::create(GlobalTable& global, std::span<const PortB
       return make_error(Errc::kInvalidInput, fmt::format("ports up to '{}' need more than 4 GiB", p.port));
     }
     table.slots_.push_back(
-        Slot{*var, p.kind, static_cast<std::uint32_t>(offset), static_cast<std::uint32_t>(bytes), 0});
+        Slot{*var, p.kind, static_cast<std::uint32_t>(offset), static_cast<std::uint32_t>(bytes), 0, -1});
     table.by_kind_[kind_index(p.kind)].push_back(static_cast<std::uint32_t>(table.slots_.size() - 1));
     if (is_input(p.kind)) largest_input_words = std::max(largest_input_words, (bytes + 7) / 8);
     offset += bytes;
@@ -109,7 +109,20 @@ void LocalTable::push(PortKind kind) noexcept {
 
 void LocalTable::pull_in_consts() noexcept { pull(PortKind::kInConst); }
 void LocalTable::pull_in_vars() noexcept { pull(PortKind::kInVar); }
-void LocalTable::push_out_vars() noexcept { push(PortKind::kOutVar); }
+
+void LocalTable::push_out_vars(std::int64_t at_ns) noexcept {
+  push(PortKind::kOutVar);
+  if (history_ == nullptr) return;
+  // NOLINTNEXTLINE(cppcoreguidelines-pro-type-reinterpret-cast): storage_ is raw max-aligned bytes
+  const auto* base = reinterpret_cast<const std::byte*>(storage_.data());
+  for (const std::uint32_t i : by_kind_[kind_index(PortKind::kOutVar)])
+    if (slots_[i].ring >= 0) history_->write(static_cast<std::size_t>(slots_[i].ring), at_ns, base + slots_[i].offset);
+}
+
+void LocalTable::keep_history(HistoryRings* rings, std::span<const std::int32_t> ring_of_var) noexcept {
+  history_ = rings;
+  for (Slot& s : slots_) s.ring = rings != nullptr && s.var < ring_of_var.size() ? ring_of_var[s.var] : -1;
+}
 void LocalTable::push_out_consts() noexcept { push(PortKind::kOutConst); }
 
 void LocalTable::reset_inputs() noexcept {

@@ -32,6 +32,8 @@ enum class Verb {
   kVerify,
   kRemove,
   kSave,
+  // The flight recorder (docs/flight-recorder.md).
+  kDump,
 };
 
 /// The word that names `verb` on the command line ("status", "on", ...).

@@ -41,6 +41,13 @@ struct RunOptions {
   /// Real clock, a file with module processes (docs/processes.md): the chimera binary that runs
   /// them ("": this program, /proc/self/exe). A program that is not chimera names it.
   std::string worker_program;
+  /// The flight recorder (docs/flight-recorder.md): how many seconds of every produced variable
+  /// and of every task's cycles are kept in memory (0: none; a history that would need more than
+  /// 256 MiB is shortened to fit). Tasks in module processes are not recorded.
+  double record_seconds = 0;
+  /// Where the recorder's dump goes when a task enters ERROR: a directory below this one, named
+  /// after the subsystem, the task and the time ("": no dump then).
+  std::string error_dump_dir;
 };
 
 /// One task as the subsystem interface sees it.
@@ -143,6 +150,15 @@ class Subsystem {
   /// refused if an ON task produces the variable.
   Result<std::vector<double>> get(std::string_view variable) const;
   Result<void> set(std::string_view variable, const std::vector<double>& values);
+
+  /// The flight recorder's history, written into directory `dir` (docs/flight-recorder.md):
+  /// variables.csv, timing.csv, summary.txt; `why` goes into the summary. `dir` empty: one named
+  /// after the subsystem and the time, below RunOptions::error_dump_dir (or chimera-dumps).
+  /// Returns the directory written. Refused when the run keeps no history (record_seconds 0).
+  /// The tasks run on meanwhile. Not real-time safe.
+  Result<std::string> dump(const std::string& dir, std::string_view why) const;
+  /// How many seconds of history the flight recorder keeps (0: none).
+  [[nodiscard]] double recorded_seconds() const;
 
   /// Every task's state and figures; last_error is current without draining events.
   [[nodiscard]] std::vector<TaskSnapshot> snapshot() const;

@@ -10,6 +10,7 @@
 #include <string_view>
 #include <vector>
 
+#include "chimera/core/history_rings.hpp"
 #include "chimera/core/result.hpp"
 #include "chimera/svt/elem_type.hpp"
 #include "chimera/svt/freshness.hpp"
@@ -39,13 +40,20 @@ class LocalTable final : public PortAccess {
   // Transfers (real-time safe): global -> local for inputs, local -> global for outputs.
   void pull_in_consts() noexcept;
   void pull_in_vars() noexcept;
-  void push_out_vars() noexcept;
+  /// Publishes the outputs' local copies; with a history kept, each is also recorded, stamped
+  /// `at_ns` (the time of the release whose cycle produced it, on the subsystem's clock).
+  void push_out_vars(std::int64_t at_ns) noexcept;
   void push_out_consts() noexcept;
 
   /// Zeros the local copies of inputs and marks them kNoData, so that a task joining a
   /// configuration reads everything anew. Outputs are the module's and keep their values.
   /// Real-time safe.
   void reset_inputs() noexcept;
+
+  /// The flight recorder (docs/flight-recorder.md): from now on each push_out_vars also writes
+  /// output variable v's value to ring `ring_of_var[v]` of `rings` (-1: not recorded); nullptr
+  /// stops it. The rings outlive the table. Not real-time safe.
+  void keep_history(HistoryRings* rings, std::span<const std::int32_t> ring_of_var) noexcept;
 
   [[nodiscard]] std::span<const PortBinding> ports() const noexcept { return ports_; }
 
@@ -56,6 +64,7 @@ class LocalTable final : public PortAccess {
     std::uint32_t offset;  // into storage_
     std::uint32_t bytes;
     std::uint64_t seen;  // version of the global value held locally
+    std::int32_t ring;   // its flight recorder ring, -1: none
   };
   LocalTable() = default;
   Result<const Slot*> find_slot(std::string_view port, bool want_input, ElemType type) const;
@@ -64,6 +73,7 @@ class LocalTable final : public PortAccess {
   void push(PortKind kind) noexcept;
 
   GlobalTable* global_ = nullptr;
+  HistoryRings* history_ = nullptr;  // the flight recorder's, or none
   std::vector<PortBinding> ports_;
   std::vector<Slot> slots_;                            // parallel to ports_
   std::vector<Freshness> freshness_;                   // parallel to ports_

@@ -152,7 +152,7 @@ TEST_F(LocalTableTest, VariablesFlowFromOutputsToInputsWithFreshness) {
 
   for (std::size_t i = 0; i < 6; ++i) gen_out[i] = 0.1 * static_cast<double>(i);
   gen_mask[1] = 1;
-  gen.push_out_vars();
+  gen.push_out_vars(0);
   pid.pull_in_vars();
   EXPECT_EQ(q_ref.freshness(), Freshness::kNew);
   EXPECT_EQ(q.freshness(), Freshness::kNoData);  // nobody writes theta_m in this test
@@ -165,7 +165,7 @@ TEST_F(LocalTableTest, VariablesFlowFromOutputsToInputsWithFreshness) {
   EXPECT_EQ(q_ref[5], 0.5);  // old values stay
 
   gen_out[0] = 42;
-  gen.push_out_vars();
+  gen.push_out_vars(0);
   pid.pull_in_vars();
   EXPECT_EQ(q_ref.freshness(), Freshness::kNew);
   EXPECT_EQ(q_ref[0], 42.0);
@@ -174,7 +174,7 @@ TEST_F(LocalTableTest, VariablesFlowFromOutputsToInputsWithFreshness) {
   tau[2] = -3;
   gen.pull_in_vars();
   EXPECT_EQ(gen_tau.freshness(), Freshness::kNoData);
-  pid.push_out_vars();
+  pid.push_out_vars(0);
   gen.pull_in_vars();
   EXPECT_EQ(gen_tau.freshness(), Freshness::kNew);
   EXPECT_EQ(gen_tau[2], -3.0);
@@ -190,7 +190,7 @@ TEST_F(LocalTableTest, ConstantsMoveOnlyWithTheirOwnTransfers) {
 
   gains_out[0] = 100;
   theta_d[0] = 1;
-  gen.push_out_vars();  // variables only
+  gen.push_out_vars(0);  // variables only
   EXPECT_EQ(global_->version(*global_->find("gains")), 0U);
   gen.push_out_consts();
   EXPECT_EQ(global_->version(*global_->find("gains")), 1U);
@@ -221,7 +221,7 @@ TEST_F(LocalTableTest, ResetInputsZerosInputsForgetsWhatWasSeenAndKeepsOutputs) 
   In<double> q_ref = *pid.input<double>("q_ref");
   Out<double> tau = *pid.output<double>("tau");
   out[3] = 7;
-  gen.push_out_vars();
+  gen.push_out_vars(0);
   pid.pull_in_vars();
   tau[0] = 5;
   ASSERT_EQ(q_ref[3], 7.0);
@@ -244,7 +244,7 @@ TEST_F(LocalTableTest, MovedTableKeepsItsViews) {
   LocalTable moved = std::move(*created);
   LocalTable gen = make(generator_ports());
   (*gen.output<double>("out"))[1] = 9;
-  gen.push_out_vars();
+  gen.push_out_vars(0);
   moved.pull_in_vars();
   EXPECT_EQ(q_ref[1], 9.0);
   EXPECT_EQ(q_ref.freshness(), Freshness::kNew);
@@ -254,7 +254,7 @@ TEST_F(LocalTableTest, NoPortsIsFine) {
   LocalTable empty = make({});
   empty.pull_in_consts();
   empty.pull_in_vars();
-  empty.push_out_vars();
+  empty.push_out_vars(0);
   empty.push_out_consts();
   empty.reset_inputs();
   EXPECT_TRUE(empty.ports().empty());

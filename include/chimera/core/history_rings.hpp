@@ -1,0 +1,65 @@
+#pragma once
+// Rings of the most recent records, many in one block of memory allocated once: the flight
+// recorder's storage (docs/flight-recorder.md). Each ring has one writer at a time, which
+// overwrites its oldest record and never waits; any thread may copy a ring out meanwhile and gets
+// only whole records (a record being overwritten as it is copied is left out, never torn).
+//
+// Protocol, per record (a sequence word, a time word, then the payload's words), for write w of a
+// ring (w = 1, 2, ...; its slot is (w - 1) % capacity):
+//   stamp = 2w-1 (relaxed); time and payload words (release); stamp = 2w (release); head = w (release)
+// Reader, for each w from head - capacity + 1 to head:
+//   s1 = stamp (acquire), must be 2w; words (acquire); s2 = stamp (relaxed); whole iff s2 == s1.
+// A word loaded by acquire that a later writer stored carries that writer's odd stamp with it, so
+// the re-check sees it: the same argument as the state variable table's (docs/state-variables.md),
+// with release/acquire on each word instead of fences, which costs nothing on x86 and which
+// ThreadSanitizer understands.
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+namespace chimera {
+
+class HistoryRings {
+ public:
+  /// A ring's place in the block: offsets into it, never pointers.
+  struct Ring {
+    std::size_t offset = 0;        // of its head word; its records follow
+    std::uint32_t capacity = 0;    // records
+    std::uint32_t payload_words = 0;
+    std::uint32_t payload_bytes = 0;
+  };
+  /// One record as copied out: its time and its payload's words.
+  struct Record {
+    std::int64_t time_ns = 0;
+    std::vector<std::uint64_t> words;
+  };
+
+  /// Declares a ring of `capacity` records of `payload_bytes` each (capacity >= 1); returns its
+  /// number. Only before allocate(). Not real-time safe.
+  std::size_t add(std::uint32_t capacity, std::uint32_t payload_bytes);
+  /// Allocates and zeroes the block for every ring declared. Not real-time safe.
+  void allocate();
+  [[nodiscard]] std::size_t rings() const noexcept { return rings_.size(); }
+  [[nodiscard]] const Ring& ring(std::size_t r) const noexcept { return rings_[r]; }
+  /// Bytes of the block.
+  [[nodiscard]] std::size_t bytes() const noexcept { return words_ * sizeof(std::uint64_t); }
+
+  /// Writes one record: ring(r).payload_bytes bytes from `payload`, stamped `time_ns`. One writer
+  /// per ring at a time (a change of writer goes through the caller's synchronisation). Real-time
+  /// safe, wait-free: a bounded copy, no allocation.
+  void write(std::size_t r, std::int64_t time_ns, const void* payload) noexcept;
+  /// Records written to ring r so far (not all of them still held). Any thread.
+  [[nodiscard]] std::uint64_t written(std::size_t r) const noexcept;
+  /// The records ring r holds, oldest first, each whole. Not real-time safe (it allocates).
+  [[nodiscard]] std::vector<Record> read(std::size_t r) const;
+
+ private:
+  std::vector<Ring> rings_;
+  std::size_t words_ = 0;
+  std::unique_ptr<std::uint64_t[]> block_;
+};
+
+}  // namespace chimera

@@ -1,0 +1,66 @@
+#pragma once
+// The flight recorder (docs/flight-recorder.md): the last few seconds of every state variable a
+// task produces and of every task's timing, kept in memory allocated once, written by the tasks'
+// own transfers (a bounded ring write per output and per cycle, nothing else on the real-time
+// path), and dumped to a directory on request: when a task enters ERROR, on `dump`, at exit.
+// Private to the control part.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "chimera/config/verify.hpp"
+#include "chimera/core/history_rings.hpp"
+#include "chimera/core/result.hpp"
+#include "chimera/svt/global_table.hpp"
+#include "exec/task_set.hpp"
+
+namespace chimera {
+
+class FlightRecorder {
+ public:
+  /// The memory the recorder may take; a longer history that would need more is shortened to fit.
+  static constexpr std::size_t kMostBytes = std::size_t{256} << 20;
+  /// Records a ring holds at most, whatever its rate.
+  static constexpr std::uint32_t kMostRecords = 1U << 20;
+
+  /// Rings for `seconds` of history of every variable that a task of `resolved` produces (at its
+  /// fastest producer's rate) and of every task's cycles, and every task of `tasks` writing into
+  /// them. `shortened` is set when the memory bound made the history shorter than asked: its
+  /// length is then seconds(). Not real-time safe.
+  FlightRecorder(const ResolvedSubsystem& resolved, const GlobalTable& table, TaskSet& tasks, double seconds);
+  FlightRecorder(const FlightRecorder&) = delete;
+  FlightRecorder& operator=(const FlightRecorder&) = delete;
+
+  /// How much history it keeps (seconds of the fastest producer), and its memory.
+  [[nodiscard]] double seconds() const noexcept { return seconds_; }
+  [[nodiscard]] bool shortened() const noexcept { return shortened_; }
+  [[nodiscard]] std::size_t bytes() const noexcept { return rings_.bytes(); }
+
+  /// Writes what it holds into directory `dir` (made if missing; its files replaced):
+  /// variables.csv (a data_logger log: t, then each element, one row per instant a variable was
+  /// written, each variable's latest value at that instant), timing.csv (one row per cycle of
+  /// every task) and summary.txt (`why`, each task's state and last error, the window). `now_ns`
+  /// is the subsystem's time. Not real-time safe; the tasks run on meanwhile.
+  [[nodiscard]] Result<void> dump(const std::string& dir, const std::string& why, std::int64_t now_ns,
+                                  const std::vector<std::string>& task_lines) const;
+
+ private:
+  struct RecordedVariable {
+    VarIndex var = 0;
+    std::size_t ring = 0;
+  };
+  Result<void> write_variables(const std::string& path) const;
+  Result<void> write_timing(const std::string& path) const;
+
+  const GlobalTable& table_;
+  TaskSet& tasks_;
+  HistoryRings rings_;
+  std::vector<std::int32_t> ring_of_var_;   // per variable of the table, -1: not recorded
+  std::vector<RecordedVariable> variables_;  // the recorded ones, in table order
+  std::vector<std::int32_t> timing_ring_;   // per task
+  double seconds_ = 0;
+  bool shortened_ = false;
+};
+
+}  // namespace chimera

@@ -1,0 +1,106 @@
+// The flight recorder through chimera run (docs/flight-recorder.md): the dump a task's ERROR
+// makes by itself, the operator's `dump`, --dump-at-exit, and --record off. On the virtual clock,
+// so that which cycle misses is exact.
+
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "run_chimera.hpp"
+
+namespace chimera::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A trajectory generator and a position-mode robot beside a hard task whose 200th cycle overruns its 1 ms period.
+std::string subsystem_file(const TempDir& dir) {
+  const std::string name = "recorder_" + std::to_string(::getpid());
+  const std::string path = dir.file("recorder.yaml");
+  write_text(path, "subsystem: " + name +
+                       "\n"
+                       "tasks:\n"
+                       "  - {name: traj, module: joint_traj_gen, period: 1ms}\n"
+                       "  - {name: robot, module: robot_position, period: 1ms}\n"
+                       "  - name: load\n"
+                       "    module: cpu_load\n"
+                       "    period: 1ms\n"
+                       "    criticality: hard\n"
+                       "    params: {exec: 0.0001, overrun_every: 200, overrun: 0.002}\n"
+                       "configurations:\n"
+                       "  all: [traj, robot, load]\n");
+  return path;
+}
+
+std::size_t lines_of(const std::string& path) {
+  std::ifstream in(path);
+  std::size_t n = 0;
+  for (std::string line; std::getline(in, line);) ++n;
+  return n;
+}
+
+TEST(FlightRecorderCli, AHardTaskEnteringErrorDumpsTheLastSecondsByItself) {
+  TempDir dir;
+  const std::string file = subsystem_file(dir);
+  const std::string dumps = dir.file("dumps");
+  const Outcome o = run_chimera(dir, "run " + quoted(file) + " --clock virtual --for 500ms --record 100ms --dump-dir " +
+                                         quoted(dumps));
+  EXPECT_EQ(o.exit_code, 1) << o.err;  // a hard task failed
+  ASSERT_TRUE(fs::is_directory(dumps)) << o.err;
+  std::string made;
+  for (const auto& entry : fs::directory_iterator(dumps)) made = entry.path().string();
+  ASSERT_FALSE(made.empty());
+  EXPECT_NE(made.find("-load-t"), std::string::npos) << made;
+  EXPECT_NE(o.err.find("load: flight recorder: the last 0.1 s written to " + made + "/"), std::string::npos) << o.err;
+  const std::string summary = read_text(made + "/summary.txt");
+  EXPECT_NE(summary.find("why: load entered ERROR"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("load: ERROR"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("traj: ON"), std::string::npos) << summary;
+  // 100 ms at 1 kHz: about 100 cycles of each of the three tasks, one of load's its missed one.
+  const std::string timing = read_text(made + "/timing.csv");
+  EXPECT_EQ(timing.rfind("task,t,latency_ns,exec_ns,response_ns,missed,overrun,failed,skipped\n", 0), 0U);
+  EXPECT_NE(timing.find(",1,0,0,0\n"), std::string::npos) << "no missed cycle in the dump";
+  const std::size_t rows = lines_of(made + "/timing.csv") - 1;
+  EXPECT_GE(rows, 290U);
+  EXPECT_LE(rows, 306U);
+  const std::string variables = read_text(made + "/variables.csv");
+  EXPECT_EQ(variables.rfind("t,dtheta_d[0],", 0), 0U) << variables.substr(0, 200);
+  EXPECT_GE(lines_of(made + "/variables.csv"), 95U);
+}
+
+TEST(FlightRecorderCli, TheOperatorsDumpAndTheOneAtExitWriteWhereTheyAreTold) {
+  TempDir dir;
+  const std::string file = subsystem_file(dir);
+  const std::string mine = dir.file("mine");
+  const Outcome o = run_chimera(dir,
+                                "run " + quoted(file) + " --clock virtual --for 150ms --dump-at-exit --dump-dir " +
+                                    quoted(dir.file("dumps")),
+                                "wait 50ms\ndump " + mine + "\n");
+  EXPECT_EQ(o.exit_code, 0) << o.err;
+  EXPECT_NE(o.out.find("the last 10 s written to " + mine + "/"), std::string::npos) << o.out;
+  EXPECT_NE(read_text(mine + "/summary.txt").find("why: the operator's dump"), std::string::npos);
+  // 50 ms of three tasks at 1 kHz, each cycle once.
+  EXPECT_GE(lines_of(mine + "/timing.csv") - 1, 150U);
+  EXPECT_LE(lines_of(mine + "/timing.csv") - 1, 156U);
+  const std::string at_exit = read_text(dir.file("dumps") + "/recorder_" + std::to_string(::getpid()) + "-exit/summary.txt");
+  EXPECT_NE(at_exit.find("why: the run's end"), std::string::npos) << o.err;
+}
+
+TEST(FlightRecorderCli, WithTheRecorderOffDumpIsRefusedAndNothingIsWritten) {
+  TempDir dir;
+  const std::string file = subsystem_file(dir);
+  const Outcome o = run_chimera(dir, "run " + quoted(file) + " --clock virtual --for 10ms --record off --dump-dir " +
+                                         quoted(dir.file("dumps")),
+                                "dump\n");
+  EXPECT_EQ(o.exit_code, 0) << o.err;
+  EXPECT_NE((o.out + o.err).find("dump: this run keeps no history (the flight recorder is off)"), std::string::npos)
+      << o.out << o.err;
+  EXPECT_FALSE(fs::exists(dir.file("dumps")));
+}
+
+}  // namespace
+}  // namespace chimera::test
