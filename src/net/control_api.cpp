@@ -257,8 +257,10 @@ ApiResponse ControlApi::command(Role role, std::string_view body) {
   json doc;
   try {
     doc = json::parse(body);
-  } catch (const json::parse_error& e) {
-    // "[json.exception.parse_error.101] parse error at line 1, ...": the part after the tag.
+  } catch (const json::exception& e) {
+    // A syntax error (parse_error) or a number too large for a double (out_of_range.406, thrown
+    // by the same parse): "[json.exception.parse_error.101] parse error at line 1, ...", of which
+    // the part after the tag is said.
     std::string_view what = e.what();
     if (const auto tag_end = what.find("] "); tag_end != std::string_view::npos) what.remove_prefix(tag_end + 2);
     return error(400, "bad_json", fmt::format("the body is not JSON: {}", what));
