@@ -46,6 +46,7 @@ help:
 # Quiet and a few milliseconds when nothing is missing, so it simply runs every time.
 setup:
 	@bash scripts/setup.sh
+	@bash scripts/setup-browser.sh
 
 setup-lint:
 	@bash scripts/setup.sh lint

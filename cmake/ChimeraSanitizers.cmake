@@ -1,6 +1,6 @@
 # CHIMERA_SANITIZE=address,undefined or thread applies to every target of this build tree.
 if(CHIMERA_SANITIZE)
-  set(_san "-fsanitize=${CHIMERA_SANITIZE} -fno-omit-frame-pointer -g")
+  set(_san "-fsanitize=${CHIMERA_SANITIZE} -fno-omit-frame-pointer -g1")
   if(CHIMERA_SANITIZE MATCHES "undefined")
     string(APPEND _san " -fno-sanitize-recover=undefined")
   endif()

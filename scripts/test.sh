@@ -30,8 +30,11 @@ stages=("$@")
 # Sanitized trees: asserts on (Debug defines no NDEBUG) at -O1, which the sanitizer manuals
 # recommend for usable speed. Warnings stay on but are not errors there: GCC's instrumentation
 # produces false -Wmaybe-uninitialized / -Wstringop-* reports, and the main tree already
-# compiles the same sources with -Werror in CI.
-san_build=(-DCMAKE_BUILD_TYPE=Debug "-DCMAKE_C_FLAGS_DEBUG=-g -O1" "-DCMAKE_CXX_FLAGS_DEBUG=-g -O1"
+# compiles the same sources with -Werror in CI. Debug information is line tables only (-g1): a
+# sanitizer's report names every frame's file and line with it, and the full -g cost a sixth of
+# the sanitizer trees' compile time (control_api.cpp under ASAN: 25.4 s, 20.9 s with -g1) on a
+# clean CI machine, which has 45 minutes for all four trees.
+san_build=(-DCMAKE_BUILD_TYPE=Debug "-DCMAKE_C_FLAGS_DEBUG=-g1 -O1" "-DCMAKE_CXX_FLAGS_DEBUG=-g1 -O1"
   -DCHIMERA_WERROR=OFF)
 
 declare -A build_status test_summary stage_time

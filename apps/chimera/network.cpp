@@ -98,9 +98,17 @@ Result<std::unique_ptr<Network>> Network::start(NetworkPlan plan, net::ControlGa
       fmt::print(stderr, "{}\n", path.error().message);
       return path.error();
     }
-    where = fmt::format("operator token {}; viewer token in {}", operator_token.value_or("?"), *path);
+    where = fmt::format("tokens in {}; the operator's is in the page's link below", *path);
   }
   fmt::print(stderr, "chimera: control API on {}api/ ({})\n", network->server_->url(), where);
+  // The page's link carries the operator's token after '#', which the browser never sends: the
+  // page keeps it for the session and takes it out of the address. The token is printed there
+  // only, once.
+  if (plan.generated && operator_token)
+    fmt::print(stderr, "chimera: Onika, the page, on {}#token={}\n", network->server_->url(), *operator_token);
+  else
+    fmt::print(stderr, "chimera: Onika, the page, on {} (it asks for a token of the token file)\n",
+               network->server_->url());
   std::fflush(stderr);
   return network;
 }

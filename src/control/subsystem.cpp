@@ -135,8 +135,8 @@ Result<void> Subsystem::Impl::build_runtime(const std::string& configuration, st
   setup.start_ns = start_ns;
   if (m.block) setup.processes = process_setup(m.spec, m.options, m.block.get(), configuration);
   m.executive = make_executive(std::move(setup));
-  m.reconfiguration = std::make_unique<Reconfiguration>(resolved, configuration, *m.requests, *m.tasks,
-                                                        *m.executive, *m.table, *m.events);
+  m.reconfiguration = std::make_unique<Reconfiguration>(resolved, configuration, *m.requests, *m.tasks, *m.executive,
+                                                        *m.table, *m.events);
   return {};
 }
 
@@ -268,6 +268,7 @@ std::int64_t Subsystem::now_ns() const {
 ClockKind Subsystem::clock() const { return impl_->options.clock; }
 const SubsystemSpec& Subsystem::spec() const { return impl_->spec; }
 const ResolvedSubsystem& Subsystem::resolved() const { return impl_->resolution.subsystem; }
+const Registry& Subsystem::registry() const { return *impl_->registry; }
 
 bool Subsystem::illegal_configuration() const {
   std::shared_lock<std::shared_mutex> lock(impl_->runtime_mutex);  // the table goes at stop
@@ -343,7 +344,7 @@ std::vector<TaskSnapshot> Subsystem::snapshot() const {
 std::vector<Event> Subsystem::drain_events() {
   Impl& m = *impl_;
   std::shared_lock<std::shared_mutex> runtime(m.runtime_mutex);  // an add replaces the log
-  m.events->collect(*m.tasks);  // the log's own lock makes it the rings' one consumer
+  m.events->collect(*m.tasks);                                   // the log's own lock makes it the rings' one consumer
   std::vector<Event> out;
   {
     std::lock_guard<std::mutex> notes(m.notes_mutex);

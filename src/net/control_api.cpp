@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "api_documents.hpp"
 #include "chimera/control/stats_json.hpp"
 
 namespace chimera::net {
@@ -123,7 +124,8 @@ std::variant<std::string, std::string> command_line(const json& doc) {
     const json& args = doc["args"];
     if (!args.is_array()) return fail("args: an array of words and numbers");
     // add's one argument is a task entry: a JSON object is also a YAML flow mapping.
-    if (line == "add" && args.size() == 1 && args[0].is_object()) return Out(std::in_place_index<0>, "add " + dump(args[0]));
+    if (line == "add" && args.size() == 1 && args[0].is_object())
+      return Out(std::in_place_index<0>, "add " + dump(args[0]));
     for (std::size_t i = 0; i < args.size(); ++i) {
       const json& a = args[i];
       std::string word;
@@ -140,17 +142,6 @@ std::variant<std::string, std::string> command_line(const json& doc) {
     }
   }
   return Out(std::in_place_index<0>, std::move(line));
-}
-
-json violations_json(const std::vector<Violation>& violations) {
-  json out = json::array();
-  for (const auto& v : violations)
-    out.push_back(json{{"rule", v.rule},
-                       {"variable", v.variable},
-                       {"tasks", v.tasks},
-                       {"reason", violation_reason(v)},
-                       {"message", v.message}});
-  return out;
 }
 
 // What the live assembly's verbs add to their reply, read right after the command.
@@ -185,7 +176,7 @@ bool verb_needs_operator(Verb verb) {
     case Verb::kHelp:
     case Verb::kVerify:
     case Verb::kSave: return false;  // save over the network only replies with the file
-    default: return true;  // signals, switch, set, wait (time passes on the virtual clock), quit
+    default: return true;            // signals, switch, set, wait (time passes on the virtual clock), quit
   }
 }
 
@@ -201,6 +192,10 @@ ApiResponse ControlApi::too_large() {
 }
 
 void ControlApi::close() { closing_ = true; }
+
+void ControlApi::sent(const ApiResponse& response) {
+  if (response.stops_subsystem && on_quit_) on_quit_();
+}
 
 std::optional<Role> ControlApi::role_of(std::string_view authorization) const {
   return tokens_.role_of(bearer_token(authorization));
@@ -244,6 +239,18 @@ ApiResponse ControlApi::handle(const ApiRequest& request) {
                            {"does", h.does},
                            {"role", verb_needs_operator(h.verb) ? "operator" : "viewer"}});
     return reply(json{{"commands", std::move(verbs)}});
+  }
+  if (path == "/api/modules") {
+    if (auto refused = only("GET")) return *refused;
+    json modules = gate_.exclusive(
+        [](Control& /*control*/, Subsystem& subsystem) { return module_library_json(subsystem.registry()); });
+    return reply(json{{"modules", std::move(modules)}});
+  }
+  if (path == "/api/subsystem") {
+    if (auto refused = only("GET")) return *refused;
+    json model =
+        gate_.exclusive([](Control& /*control*/, Subsystem& subsystem) { return subsystem_model_json(subsystem); });
+    return reply(json{{"subsystem", std::move(model)}});
   }
   constexpr std::string_view kVariables = "/api/variables/";
   if (path.substr(0, kVariables.size()) == kVariables) {
@@ -296,7 +303,6 @@ ApiResponse ControlApi::command(Role role, std::string_view body) {
     }
     return std::pair{std::move(done), std::move(more)};
   });
-  if (r.quit && on_quit_) on_quit_();
 
   extra["verb"] = verb;
   extra["text"] = r.text;
@@ -310,7 +316,9 @@ ApiResponse ControlApi::command(Role role, std::string_view body) {
     if (auto values = values_of(r.text)) extra["values"] = *values;
   }
   if (r.quit) extra["stopping"] = true;
-  return reply(std::move(extra));
+  ApiResponse done = reply(std::move(extra));
+  done.stops_subsystem = r.quit;
+  return done;
 }
 
 ApiResponse ControlApi::status() {

@@ -10,16 +10,11 @@
 #include <spdlog/spdlog.h>
 
 #include "chimera/net/variable_streams.hpp"
+#include "page_files.hpp"
 
 namespace chimera::net {
 
 namespace {
-
-constexpr std::string_view kPlaceholderPage =
-    "<!doctype html>\n<html><head><meta charset=\"utf-8\"><title>Chimera</title></head>\n"
-    "<body><h1>Chimera</h1><p>The subsystem's control API is under <code>/api/</code> (see "
-    "docs/control-api.md in the source tree). The page that assembles and runs subsystems from "
-    "the browser is not served yet.</p></body></html>\n";
 
 int log_message(const mg_connection* /*conn*/, const char* message) {
   spdlog::warn("network: {}", message);
@@ -35,6 +30,11 @@ void send(mg_connection* conn, int status, std::string_view type, std::string_vi
   mg_response_header_add(conn, "X-Content-Type-Options", "nosniff", -1);
   if (status == 401) mg_response_header_add(conn, "WWW-Authenticate", "Bearer realm=\"chimera\"", -1);
   if (!allow.empty()) mg_response_header_add(conn, "Allow", allow.c_str(), -1);
+  // The page runs only its own files: no inline script, nothing from another origin.
+  mg_response_header_add(conn, "Content-Security-Policy",
+                         "default-src 'self'; img-src 'self' data: blob:; connect-src 'self'; object-src 'none'; "
+                         "frame-ancestors 'none'",
+                         -1);
   mg_response_header_send(conn);
   if (!body.empty()) mg_write(conn, body.data(), body.size());
 }
@@ -135,6 +135,7 @@ int HttpServer::serve_api(mg_connection* conn, void* self) {
   }
   const ApiResponse response = server.api_.handle(request);
   send(conn, response.status, "application/json", response.body, response.allow);
+  server.api_.sent(response);
   return response.status;
 }
 
@@ -182,7 +183,10 @@ int HttpServer::serve_page(mg_connection* conn, void* /*self*/) {
   const mg_request_info* info = mg_get_request_info(conn);
   const std::string_view path = info->local_uri != nullptr ? info->local_uri : "";
   const std::string_view method = info->request_method;
-  if (path != "/" && path != "/index.html") {
+  // The page's files are public (the token is asked for by the page, and every /api/ request
+  // needs it): Onika's own files, embedded at build time, and nothing else.
+  const PageFile* file = find_page_file(path);
+  if (file == nullptr) {
     send(conn, 404, "text/plain; charset=utf-8", "not found\n", {});
     return 404;
   }
@@ -190,7 +194,7 @@ int HttpServer::serve_page(mg_connection* conn, void* /*self*/) {
     send(conn, 405, "text/plain; charset=utf-8", "GET only\n", "GET, HEAD");
     return 405;
   }
-  send(conn, 200, "text/html; charset=utf-8", method == "HEAD" ? std::string_view{} : kPlaceholderPage, {});
+  send(conn, 200, file->content_type, method == "HEAD" ? std::string_view{} : file->body, {});
   return 200;
 }
 

@@ -116,6 +116,8 @@ class Subsystem {
   /// the commands).
   [[nodiscard]] const SubsystemSpec& spec() const;
   [[nodiscard]] const ResolvedSubsystem& resolved() const;
+  /// The module library its tasks are made from (and the live assembly adds from).
+  [[nodiscard]] const Registry& registry() const;
   /// Whether the illegal-configuration flag is up now (paper 3.4). Any thread.
   [[nodiscard]] bool illegal_configuration() const;
 

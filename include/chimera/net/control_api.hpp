@@ -30,6 +30,8 @@ struct ApiResponse {
   int status = 200;
   std::string body;   // JSON, one line
   std::string allow;  // for 405: the methods the path takes ("GET")
+  /// A `quit` was accepted: once the reply is on its way (ControlApi::sent), the subsystem stops.
+  bool stops_subsystem = false;
 };
 
 /// Whether `verb` can change the subsystem (or its time): only operators may send it.
@@ -42,7 +44,9 @@ class ControlApi {
   /// The longest `wait` over the network: a request thread is not parked for longer.
   static constexpr std::int64_t kMaxWaitNs = 60'000'000'000;
 
-  /// `on_quit` is called after a `quit` was accepted: the owner of the subsystem stops it.
+  /// `on_quit` is called once the reply to an accepted `quit` was sent (sent()): the owner of
+  /// the subsystem stops it. Before, the server could stop before the reply left, and the client
+  /// saw its connection closed instead of the reply.
   ControlApi(ControlGate& gate, AccessTokens tokens, std::function<void()> on_quit = {});
 
   /// Carries out one request: 401 without a known token (nothing else is looked at), then 404,
@@ -50,6 +54,10 @@ class ControlApi {
   /// command the subsystem refused (nothing changed), 200 otherwise. Any thread; commands are
   /// serialised by the gate. Not real-time safe.
   ApiResponse handle(const ApiRequest& request);
+
+  /// The transport calls this after it wrote `response`: a quit's reply has left, so the
+  /// subsystem may stop now.
+  void sent(const ApiResponse& response);
 
   /// The role of an Authorization header's bearer token; none for no or a wrong token.
   [[nodiscard]] std::optional<Role> role_of(std::string_view authorization) const;

@@ -173,7 +173,7 @@ TEST_F(ControlApiHttpTest, EveryShellCommandOverHttp) {
   for (const auto& c : commands) roles[c["verb"].get<std::string>()] = c["role"].get<std::string>();
   EXPECT_EQ(roles["status"], "viewer");
   EXPECT_EQ(roles["on"], "operator");
-  EXPECT_EQ(roles["add"], "operator");  // live assembly changes the subsystem
+  EXPECT_EQ(roles["add"], "operator");   // live assembly changes the subsystem
   EXPECT_EQ(roles["verify"], "viewer");  // checks, changes nothing
   EXPECT_EQ(roles["save"], "viewer");    // over the network save only replies with the file
   EXPECT_EQ(roles["dump"], "operator");  // writes files on the server's machine
@@ -429,9 +429,13 @@ TEST_F(ControlApiHttpTest, AGeneratedTokenIsPrintedOnceAndWrittenPrivately) {
   ASSERT_GT(port_, 0) << p->err();
   std::smatch m;
   const std::string err = p->err();
-  ASSERT_TRUE(std::regex_search(err, m, std::regex("operator token ([0-9a-f]{64}); viewer token in ([^ )]+)"))) << err;
+  ASSERT_TRUE(std::regex_search(err, m, std::regex("tokens in ([^ ;)]+); the operator's is in the page's link below")))
+      << err;
+  const std::string path = m[1];
+  ASSERT_TRUE(
+      std::regex_search(err, m, std::regex("Onika, the page, on http://127.0.0.1:[0-9]+/#token=([0-9a-f]{64})\n")))
+      << err;
   const std::string token = m[1];
-  const std::string path = m[2];
   EXPECT_EQ(path,
             dir_.path() + "/chimera/" +
                 json::parse(body_of(command(port_, token, "status"))["status"]["subsystem"].dump()).get<std::string>() +
@@ -491,12 +495,30 @@ TEST_F(ControlApiHttpTest, ServeStartsAnEmptySubsystem) {
   EXPECT_EQ(body_of(r)["status"]["tasks"], json::array());
   EXPECT_EQ(body_of(r)["status"]["configuration"], "empty");
   EXPECT_REPLY(run("switch other"), 409);
-  // GET / is a placeholder page until the browser's page is served there.
+  // GET / is Onika, the page, and /static/ its files (embedded at build time), with no token;
+  // nothing else is served outside /api/.
   const HttpResponse page = http(port_, HttpRequest{"GET", "/", ""});
   EXPECT_EQ(page.status, 200);
   EXPECT_TRUE(contains(page.header("content-type"), "text/html"));
-  EXPECT_TRUE(contains(page.body, "/api/"));
+  EXPECT_TRUE(contains(page.body, "/static/js/main.js")) << page.body;
+  EXPECT_TRUE(contains(page.header("content-security-policy"), "default-src 'self'"));
+  const HttpResponse script = http(port_, HttpRequest{"GET", "/static/js/canvas.js", ""});
+  EXPECT_EQ(script.status, 200);
+  EXPECT_TRUE(contains(script.header("content-type"), "text/javascript"));
+  EXPECT_TRUE(contains(script.body, "export class Canvas"));
+  EXPECT_EQ(http(port_, HttpRequest{"GET", "/static/nosuch.js", ""}).status, 404);
+  EXPECT_EQ(http(port_, HttpRequest{"GET", "/static/../CMakeLists.txt", ""}).status, 404);
   EXPECT_EQ(http(port_, HttpRequest{"GET", "/nosuch", ""}).status, 404);
+  EXPECT_EQ(http(port_, HttpRequest{"POST", "/", ""}).status, 405);
+  // The documents the page is drawn from need a token as every /api/ request does.
+  EXPECT_EQ(http(port_, HttpRequest{"GET", "/api/modules", ""}).status, 401);
+  const HttpResponse modules = http(port_, HttpRequest{"GET", "/api/modules", kViewer});
+  EXPECT_REPLY(modules, 200);
+  EXPECT_GT(body_of(modules)["modules"].size(), 10U);
+  const HttpResponse model = http(port_, HttpRequest{"GET", "/api/subsystem", kViewer});
+  EXPECT_REPLY(model, 200);
+  EXPECT_EQ(body_of(model)["subsystem"]["configuration"], "empty");
+  EXPECT_EQ(http(port_, HttpRequest{"POST", "/api/subsystem", kOperator}).status, 405);
   EXPECT_REPLY(run("quit"), 200);
   EXPECT_EQ(p->wait_exit(), 0) << p->err();
 }

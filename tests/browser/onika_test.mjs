@@ -1,0 +1,239 @@
+// Onika in a real browser (issue 14, section 3): Debian's chromium, headless, driven by
+// playwright-core, against a real `chimera serve` / `chimera run --listen` on loopback. Each test
+// does what a user does with the mouse and checks what the subsystem did, not only what the page
+// shows: the saved file is verified by `chimera verify`, states are read back from the API.
+//
+//   CHIMERA_BIN=build/apps/chimera/chimera node --test tests/browser/onika_test.mjs
+//
+// Screenshots go to ONIKA_SCREENSHOTS (default: a temporary folder).
+
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { spawn, spawnSync } from 'node:child_process';
+import { mkdtempSync, readFileSync, writeFileSync, mkdirSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join, dirname } from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { chromium } from 'playwright-core';
+
+const here = dirname(fileURLToPath(import.meta.url));
+const source = join(here, '..', '..');
+const chimera = process.env.CHIMERA_BIN || join(source, 'build', 'apps', 'chimera', 'chimera');
+const browserPath = process.env.CHROMIUM || '/usr/bin/chromium';
+const work = mkdtempSync(join(tmpdir(), 'onika-test-'));
+const shots = process.env.ONIKA_SCREENSHOTS || join(work, 'screenshots');
+mkdirSync(shots, { recursive: true });
+
+let browser;
+
+before(async () => {
+  browser = await chromium.launch({
+    executablePath: browserPath,
+    headless: true,
+    // As root in a sandbox without a network: no sandbox, and none of chromium's own traffic.
+    args: ['--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking',
+      '--disable-component-update', '--disable-sync'],
+  });
+});
+
+after(async () => {
+  if (browser) await browser.close();
+});
+
+/** Starts chimera with `args`; resolves with the page's link (token included) from its stderr. */
+function startChimera(args, name) {
+  const logs = join(work, name);
+  mkdirSync(logs, { recursive: true });
+  const child = spawn(chimera, args, { env: { ...process.env, CHIMERA_LOG_DIR: logs }, stdio: ['pipe', 'pipe', 'pipe'] });
+  let err = '';
+  const link = new Promise((resolve, reject) => {
+    const timer = setTimeout(() => reject(new Error(`no page link from chimera within 20 s:\n${err}`)), 20000);
+    child.stderr.on('data', (chunk) => {
+      err += chunk;
+      const m = err.match(/Onika, the page, on (http:\/\/\S+#token=\S+)/);
+      if (m) {
+        clearTimeout(timer);
+        resolve(m[1]);
+      }
+    });
+    child.on('exit', (code) => reject(new Error(`chimera exited (${code}) before serving:\n${err}`)));
+  });
+  child.stdout.on('data', () => {});
+  return { child, link, stderr: () => err, logs };
+}
+
+async function stopChimera(run) {
+  const done = new Promise((resolve) => run.child.on('exit', (code) => resolve(code)));
+  run.child.stdin.end('quit\n');
+  const timer = setTimeout(() => run.child.kill('SIGKILL'), 15000);
+  const code = await done;
+  clearTimeout(timer);
+  return code;
+}
+
+async function openPage(link) {
+  const context = await browser.newContext({ viewport: { width: 1600, height: 1000 } });
+  const page = await context.newPage();
+  const problems = [];
+  page.on('pageerror', (e) => problems.push(`page error: ${e.message}`));
+  // A refused command is a 409 reply, which the browser logs as a failed load: that one is the
+  // API at work (the page shows its reason); any other error, a missing file above all, is not.
+  page.on('console', (m) => m.type() === 'error' && !m.text().includes('status of 409') && problems.push(`console: ${m.text()}`));
+  await page.goto(link);
+  await page.waitForSelector('body[data-ready=true]', { timeout: 15000 });
+  return { page, context, problems };
+}
+
+/** What the API says the tasks' states are, with the token the page was given. */
+async function apiStatus(link) {
+  const url = new URL(link);
+  const token = new URLSearchParams(url.hash.slice(1)).get('token');
+  const r = await fetch(new URL('/api/status', url), { headers: { Authorization: `Bearer ${token}` } });
+  return (await r.json()).status;
+}
+
+/** Drags module `module` from the library onto the canvas and adds it as task `name`. */
+async function dragIn(page, module, name, { criticality = 'hard', period = '1ms', params = '' } = {}) {
+  await page.dragAndDrop(`#library-list li[data-module="${module}"]`, '#canvas');
+  await page.waitForSelector('#add-dialog[open]');
+  await page.fill('#add-name', name);
+  await page.fill('#add-period', period);
+  await page.selectOption('#add-criticality', criticality);
+  await page.fill('#add-params', params);
+  await page.click('#add-ok');
+  await page.waitForSelector(`#canvas g.task[data-task="${name}"]`, { timeout: 10000 });
+}
+
+async function waitForState(page, task, state) {
+  await page.waitForSelector(`#tasks tr[data-task="${task}"][data-state="${state}"]`, { timeout: 15000 });
+}
+
+test('assembles Figure 4 from an empty canvas, runs it, plots it and saves a file chimera verify accepts', async () => {
+  const run = startChimera(['serve', '--listen', '127.0.0.1:0'], 'fig4');
+  const link = await run.link;
+  const { page, context, problems } = await openPage(link);
+  try {
+    // The library: searched by port.
+    await page.fill('#library-search', 'produces tau_r');
+    const producers = await page.$$eval('#library-list li', (items) => items.map((i) => i.dataset.module));
+    assert.ok(producers.includes('pid_joint'), `pid_joint produces tau_r: ${producers}`);
+    assert.ok(!producers.includes('robot_torque'), 'robot_torque consumes tau_r, it does not produce it');
+    await page.click('#library-list li[data-module="pid_joint"]');
+    await page.waitForSelector('#details article.module-page[data-module="pid_joint"]');
+    await page.fill('#library-search', '');
+
+    // Soft tasks: a shared test machine may miss a deadline, which is the next test's subject.
+    // The robot interface first: its out-const ndof sizes the others' ports, so the others are
+    // refused before it, with that reason in the form.
+    await page.dragAndDrop('#library-list li[data-module="joint_traj_gen"]', '#canvas');
+    await page.waitForSelector('#add-dialog[open]');
+    await page.click('#add-ok');
+    await page.waitForFunction(() => document.querySelector('#add-error').textContent.includes('add first the task that gives the constant'));
+    await page.click('#add-cancel');
+    await dragIn(page, 'robot_torque', 'robot', { criticality: 'soft' });
+    await dragIn(page, 'joint_traj_gen', 'traj', { criticality: 'soft', params: '{loop: true}' });
+    // Two of three: verified on the edit, the missing producer named and drawn in red.
+    await page.waitForFunction(() => document.querySelector('#verdict').textContent.includes('tau_r has no producer'));
+    assert.ok(await page.$('#canvas .port.bad[data-variable="tau_r"]'), 'the unproduced tau_r is highlighted');
+    assert.equal(await page.isDisabled('#switch'), true, 'an illegal configuration cannot be switched to');
+    await page.screenshot({ path: join(shots, 'onika-fig4-missing-producer.png') });
+
+    await dragIn(page, 'pid_joint', 'pid', { criticality: 'soft' });
+    await page.waitForFunction(() => document.querySelector('#verdict').textContent === 'legal');
+    // The links follow from the port names: the loop of Figure 4, and the fan-out of theta_m.
+    for (const [from, to, variable] of [['traj', 'pid', 'theta_d'], ['pid', 'robot', 'tau_r'], ['robot', 'pid', 'theta_m']])
+      assert.ok(await page.$(`#canvas path.link[data-from="${from}"][data-to="${to}"][data-variable="${variable}"]`), `${from} -> ${to} (${variable})`);
+    assert.equal(await page.$$eval('#canvas .bad', (n) => n.length), 0, 'nothing is highlighted once legal');
+
+    await page.click('#switch');
+    for (const task of ['traj', 'pid', 'robot']) await waitForState(page, task, 'ON');
+    const status = await apiStatus(link);
+    assert.equal(status.configuration, 'assembly');
+    assert.deepEqual(status.tasks.map((t) => t.state), ['ON', 'ON', 'ON']);
+
+    // A live plot of the arm's joints: samples arrive and the values move.
+    await page.selectOption('#plot-variables', ['theta_d', 'theta_m']);
+    await page.fill('#plot-rate', '200');
+    await page.click('#plot-live');
+    await page.waitForFunction(() => Number(document.querySelector('#plot').dataset.samples || 0) > 50, null, { timeout: 15000 });
+    // The trajectory loops (loop: true): the arm is moving or about to, whenever the plot starts.
+    const first = await page.$eval('#plot', (c) => c.dataset.latest);
+    await page.waitForFunction((seen) => document.querySelector('#plot').dataset.latest !== seen, first, { timeout: 15000 });
+    await page.screenshot({ path: join(shots, 'onika-fig4.png') });
+
+    // Save: the file the page shows is one chimera verify accepts.
+    await page.click('#save');
+    await page.waitForSelector('#save-dialog[open]');
+    const yaml = await page.inputValue('#save-text');
+    const file = join(work, 'saved_fig4.yaml');
+    writeFileSync(file, yaml);
+    const verified = spawnSync(chimera, ['verify', file], { encoding: 'utf8' });
+    assert.equal(verified.status, 0, `chimera verify ${file}: ${verified.stdout}${verified.stderr}\n${yaml}`);
+    assert.match(yaml, /pid_joint/);
+    assert.deepEqual(problems, []);
+  } finally {
+    await context.close();
+    assert.equal(await stopChimera(run), 0, run.stderr());
+  }
+});
+
+test('a task in ERROR shows its message and the clear button brings it back', async () => {
+  const run = startChimera(['serve', '--listen', '127.0.0.1:0'], 'error');
+  const link = await run.link;
+  const { page, context, problems } = await openPage(link);
+  try {
+    // A hard task whose cycle takes 5 ms of a 2 ms period misses its first deadline.
+    await dragIn(page, 'cpu_load', 'load', { period: '2ms', params: '{exec: 0.005}' });
+    await page.waitForFunction(() => document.querySelector('#verdict').textContent === 'legal');
+    await page.click('#switch');
+    await waitForState(page, 'load', 'ERROR');
+    const message = await page.textContent('#tasks tr[data-task="load"] .error-text');
+    assert.ok(message.length > 0, 'the ERROR has its message');
+    assert.ok(await page.$('#canvas g.task.state-ERROR[data-task="load"]'), 'the canvas shows ERROR by colour');
+    await page.screenshot({ path: join(shots, 'onika-error.png') });
+    await page.click('#tasks tr[data-task="load"] button[data-action="clear"]');
+    await waitForState(page, 'load', 'OFF');
+    assert.equal((await apiStatus(link)).tasks[0].state, 'OFF');
+    assert.deepEqual(problems, []);
+  } finally {
+    await context.close();
+    await stopChimera(run);
+  }
+});
+
+test('Figures 8 and 9: two configurations of one file side by side, switched with one click', async () => {
+  // examples/visual_servo.yaml (standard is Figure 8, near_singularity Figure 9) without the
+  // monitor's switch requests, so that only the clicks switch, and with its hard tasks soft: a
+  // shared test machine may miss a deadline, which is not this test's subject.
+  const example = readFileSync(join(source, 'examples', 'visual_servo.yaml'), 'utf8');
+  const text = example.slice(0, example.indexOf('\nrequests:') + 1).replaceAll('    period: 1ms\n', '    period: 1ms\n    criticality: soft\n');
+  assert.ok(text.includes('near_singularity: [') && text.includes('criticality: soft\n    params: { gain: 20 }'), 'the example changed: adapt this test');
+  const file = join(work, 'visual_servo.yaml');
+  writeFileSync(file, text);
+  const run = startChimera(['run', file, '--listen', '127.0.0.1:0'], 'fig89');
+  const link = await run.link;
+  const { page, context, problems } = await openPage(link);
+  try {
+    await page.click('#configuration-tabs button[data-configuration="standard"]');
+    await page.selectOption('#compare-with', 'near_singularity');
+    await page.waitForSelector('#compare-canvas g.task[data-task="dls"]');
+    assert.ok(await page.$('#canvas g.task[data-task="ik"]'), 'Figure 8 has inverse kinematics');
+    assert.equal(await page.$('#canvas g.task[data-task="dls"]'), null, 'Figure 8 has no damped least squares');
+    assert.ok(await page.$('#compare-canvas path.link[data-from="dls"][data-to="integ"]'), 'Figure 9: dls -> integ');
+    await waitForState(page, 'ik', 'ON');
+    await page.screenshot({ path: join(shots, 'onika-fig8-fig9.png') });
+    await page.click('#compare-switch');
+    await page.waitForFunction(() => document.querySelector('#configuration-on').textContent === 'on: near_singularity', null, { timeout: 15000 });
+    await waitForState(page, 'dls', 'ON');
+    await waitForState(page, 'ik', 'OFF');
+    assert.equal((await apiStatus(link)).configuration, 'near_singularity');
+    await page.click('#switch');
+    await page.waitForFunction(() => document.querySelector('#configuration-on').textContent === 'on: standard', null, { timeout: 15000 });
+    await waitForState(page, 'ik', 'ON');
+    assert.equal((await apiStatus(link)).illegal_configuration, false);
+    assert.deepEqual(problems, []);
+  } finally {
+    await context.close();
+    await stopChimera(run);
+  }
+});
