@@ -4,7 +4,10 @@
 // cycle (bench_null_pid). Each iteration first writes the four inputs, as the producers would,
 // so every pull copies new values; BM_ProducerWrites alone is subtracted by bench/run.py:
 //   cycle_overhead_ns = BM_PidCycleFramework - BM_ProducerWrites.
-// BM_PidCycleReal runs the real pid_joint for comparison.
+// BM_PidCycleReal runs the real pid_joint for comparison. BM_PidCycleRecorded is the framework's
+// cycle with the flight recorder on (docs/flight-recorder.md): tau_r's value and the cycle's
+// timing record written into rings, as `chimera run` does by default; bench/run.py reports
+//   flight_recorder_cost_ns = BM_PidCycleRecorded - BM_PidCycleFramework.
 
 #include <unistd.h>
 
@@ -13,12 +16,14 @@
 #include <cstdlib>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>
 
 #include "chimera/config/loader.hpp"
 #include "chimera/config/verify.hpp"
+#include "chimera/core/history_rings.hpp"
 #include "chimera/svt/global_table.hpp"
 #include "exec/task.hpp"
 
@@ -37,7 +42,7 @@ struct NoFlags final : SubsystemFlags {
 /// Figure 4's variables in a global table, and one task bound to them.
 class PidFixture {
  public:
-  explicit PidFixture(const std::string& module) {
+  explicit PidFixture(const std::string& module, bool recorded = false) {
     const std::string yaml = fmt::format(
         "subsystem: bench_cycle\nconstants:\n  ndof: 6\ntasks:\n  - name: pid\n    module: {}\n    period: 1ms\n"
         "configurations:\n  c: [pid]\n",
@@ -54,6 +59,17 @@ class PidFixture {
     table_->write(*table_->find("ndof"), &ndof);
     for (const char* v : {"theta_d", "dtheta_d", "theta_m", "dtheta_m"}) inputs_[n_inputs_++] = *table_->find(v);
     task_ = std::make_unique<Task>(resolution_->subsystem.tasks.front(), *table_, flags_);
+    if (recorded) {
+      // 10 s at 1 kHz, as the recorder keeps by default: a ring for the task's one output and
+      // one for its cycles, sized as src/control/flight_recorder.cpp sizes them.
+      constexpr std::uint32_t kRecords = 10'000;
+      ring_of_var_.assign(table_->size(), -1);
+      const VarIndex tau = *table_->find("tau_r");
+      ring_of_var_[tau] = static_cast<std::int32_t>(rings_.add(kRecords, 6 * sizeof(double)));
+      const auto timing = static_cast<std::int32_t>(rings_.add(kRecords, sizeof(CycleRecord)));
+      rings_.allocate();
+      task_->keep_history(&rings_, timing, ring_of_var_);
+    }
     if (auto r = task_->apply(Signal::kSpawn, 0); !r) die(r.error().message);
     if (auto r = task_->apply(Signal::kOn, 0); !r) die(r.error().message);
   }
@@ -79,6 +95,8 @@ class PidFixture {
   std::unique_ptr<SubsystemSpec> spec_;
   std::unique_ptr<Resolution> resolution_;
   std::unique_ptr<GlobalTable> table_;
+  HistoryRings rings_;                     // outlives the task, which writes into it
+  std::vector<std::int32_t> ring_of_var_;  // per variable of the table
   std::unique_ptr<Task> task_;
   std::array<VarIndex, 4> inputs_{};
   std::size_t n_inputs_ = 0;
@@ -112,9 +130,19 @@ void BM_PidCycleReal(benchmark::State& state) {
   }
 }
 
+void BM_PidCycleRecorded(benchmark::State& state) {
+  PidFixture f("bench_null_pid", /*recorded=*/true);
+  for (auto _ : state) {
+    f.write_inputs();
+    f.cycle();
+    benchmark::ClobberMemory();
+  }
+}
+
 BENCHMARK(BM_ProducerWrites);
 BENCHMARK(BM_PidCycleFramework);
 BENCHMARK(BM_PidCycleReal);
+BENCHMARK(BM_PidCycleRecorded);
 
 }  // namespace
 }  // namespace chimera::bench
