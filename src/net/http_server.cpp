@@ -59,7 +59,10 @@ Result<std::unique_ptr<HttpServer>> HttpServer::start(ControlApi& api, const Lis
     return make_error(Errc::kSystem, fmt::format("--listen {}: this civetweb has no IPv6", address.text(address.port)));
   std::unique_ptr<HttpServer> server(new HttpServer(api, address));
   const std::string ports = address.civetweb_ports();
-  const std::string threads = std::to_string(kThreads);
+  // civetweb serves a WebSocket on the thread that accepted it for as long as it is open: one
+  // thread for each stream allowed beside the request threads, or a full set of streams would
+  // leave no thread for requests (seen: 16 streams made every request wait for a thread).
+  const std::string threads = std::to_string(kThreads + kMaxStreams);
   const std::string timeout = std::to_string(kRequestTimeoutMs);
   // No document_root: civetweb serves no file of its own, only the handlers below.
   std::array<const char*, 13> options{"listening_ports",

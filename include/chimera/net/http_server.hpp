@@ -25,7 +25,8 @@ class HttpServer {
   /// How long a request may take to arrive, and a reply to be taken by the client, before the
   /// connection is dropped: a stalled or slow client frees its thread after this.
   static constexpr int kRequestTimeoutMs = 5000;
-  /// Open WebSocket streams at most (each has a thread of its own); more are refused.
+  /// Open WebSocket streams at most (each has a thread of its own, and holds a server thread
+  /// beside the request threads); more are refused at once.
   static constexpr int kMaxStreams = 32;
 
   /// Listens on `address` and serves `api` until stop() or destruction. `api` must outlive

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <csignal>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -119,6 +120,30 @@ TEST_F(ControlApiStreamTest, SamplesComeAtTheClientsRate) {
   const auto first = frames[1]["t_ns"].get<std::int64_t>();
   const auto last = frames.back()["t_ns"].get<std::int64_t>();
   EXPECT_GE(last - first, static_cast<std::int64_t>(frames.size() - 2) * 5'000'000 - 1'000'000);
+}
+
+// A stream holds a server thread for as long as it is open. The server keeps one for each stream
+// it allows (32, HttpServer::kMaxStreams) beside its request threads: with every stream open the
+// API still answers at once, and one stream more is refused at once.
+TEST_F(ControlApiStreamTest, TheMostStreamsLeaveRequestsServedAndOneMoreIsRefused) {
+  constexpr int kMostStreams = 32;
+  std::vector<std::unique_ptr<Received>> received;
+  std::vector<mg_connection*> streams;
+  for (int i = 0; i < kMostStreams; ++i) {
+    received.push_back(std::make_unique<Received>());
+    mg_connection* conn = open_stream(port_, kViewer, *received.back());
+    ASSERT_NE(conn, nullptr) << "stream " << i;
+    streams.push_back(conn);
+    subscribe(conn, R"({"variables": ["theta_m"], "rate_hz": 20})");
+  }
+  for (auto& r : received) EXPECT_GE(r->wait_for(3).size(), 3U) << "the ack and two samples";
+  const auto start = std::chrono::steady_clock::now();
+  const HttpResponse status = http(port_, HttpRequest{"GET", "/api/status", kViewer});
+  EXPECT_EQ(status.status, 200) << status.body;
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(3)) << "a request waited for a thread";
+  Received extra;
+  EXPECT_EQ(open_stream(port_, kViewer, extra), nullptr) << "one stream more than the most";
+  for (mg_connection* conn : streams) mg_close_connection(conn);
 }
 
 TEST_F(ControlApiStreamTest, AWrongTokenGetsNoStream) {
