@@ -22,8 +22,21 @@ std::string error_text(std::string_view code, std::string_view message) {
 
 }  // namespace
 
-VariableStream::VariableStream(ControlGate& gate, mg_connection* conn)
-    : gate_(gate), conn_(conn), thread_([this] { run(); }) {}
+VariableStream::VariableStream(ControlGate& gate, mg_connection* conn) : gate_(gate), conn_(conn) {
+  constexpr std::size_t kStackBytes = std::size_t{256} << 10;  // a sample's JSON needs a few KiB
+  pthread_attr_t attributes;
+  pthread_attr_init(&attributes);
+  pthread_attr_setstacksize(&attributes, kStackBytes);
+  const int failed = pthread_create(
+      &thread_, &attributes,
+      [](void* self) -> void* {
+        static_cast<VariableStream*>(self)->run();
+        return nullptr;
+      },
+      this);
+  pthread_attr_destroy(&attributes);
+  started_ = failed == 0;  // without its thread the stream sends nothing; the client sees no ack
+}
 
 VariableStream::~VariableStream() {
   {
@@ -31,7 +44,7 @@ VariableStream::~VariableStream() {
     stopping_ = true;
   }
   changed_.notify_all();
-  thread_.join();
+  if (started_) pthread_join(thread_, nullptr);
 }
 
 void VariableStream::receive(std::string_view text) {
