@@ -37,7 +37,7 @@ stages=("$@")
 san_build=(-DCMAKE_BUILD_TYPE=Debug "-DCMAKE_C_FLAGS_DEBUG=-g1 -O1" "-DCMAKE_CXX_FLAGS_DEBUG=-g1 -O1"
   -DCHIMERA_WERROR=OFF)
 
-declare -A build_status test_summary stage_time
+declare -A build_status test_summary stage_time failed_tests
 total_passed=0
 total_failed=0
 any_failed=0
@@ -83,6 +83,9 @@ run_stage() {
     failed="$(sed -E 's/.* ([0-9]+) tests? failed out of.*/\1/' <<<"${line}")"
     passed=$(($(sed -E 's/.*failed out of ([0-9]+).*/\1/' <<<"${line}") - failed))
     test_summary[${name}]="${passed} passed, ${failed} failed"
+    # ctest lists each failure as "  N - NAME (Failed)" after "The following tests FAILED:".
+    failed_tests[${name}]="$(sed -n '/^The following tests FAILED:/,/^[^[:space:]]/p' "${log}" |
+      sed -nE 's/^[[:space:]]+[0-9]+ - (.*)$/\1/p')"
   else
     test_summary[${name}]="no tests"
   fi
@@ -148,6 +151,12 @@ for stage in "${stages[@]}"; do
   t=${stage_time[${stage}]}
   printf '  %-6s %-7s %-40s %dm%02ds\n' "${stage}" "${build_status[${stage}]}" "${test_summary[${stage}]}" \
     $((t / 60)) $((t % 60))
+done
+# Named again here because CI shows only the end of the log: which test failed must be in it.
+for stage in "${stages[@]}"; do
+  [[ -n "${failed_tests[${stage}]:-}" ]] || continue
+  echo "  failed in ${stage}:"
+  sed 's/^/    /' <<<"${failed_tests[${stage}]}"
 done
 # The closing line counts the tests of all trees; a tree that did not build counts as one failure.
 echo "chimera: ${total_passed} passed, ${total_failed} failed"

@@ -295,13 +295,19 @@ TEST_F(ResourcesCliTest, NoSequenceOfStopSignalsLeavesTheRegionBehind) {
       const std::string n = tracked(name("signals"));
       RunningChimera run(dir_, {"run", file(n)});
       ASSERT_TRUE(wait_for_region(n)) << run.output();
+      const auto first_sent = std::chrono::steady_clock::now();
       for (const int s : sequence) {
         run.signal(s);
         std::this_thread::sleep_for(gap);
       }
+      const auto sending = std::chrono::steady_clock::now() - first_sent;
       const int status = run.wait(60s);
       ASSERT_NE(status, -1) << said << "did not end";
       EXPECT_FALSE(std::filesystem::exists(region_path(n))) << said << "left " << region_path(n);
+      // This test's subject, above, holds whatever the timing. What follows needs the signals to
+      // have gone within the grace: a machine that held this thread up for most of a second (a
+      // SCHED_FIFO test beside it on both CPUs) made the last one a second request, rightly.
+      if (sending > 500ms) continue;
       // Signals within a second of the first are one request (timeout(1) itself sends two): the
       // clean stop, with its timing table. A later one would end a stuck stop at once, its shared
       // memory removed first (GlobalTable.TheSignalTimeRemovalTakesOnlyThisProcesssOwnNames).

@@ -46,15 +46,20 @@ TEST(RealSwitch, SwitchesBackAndForthOnRealThreads) {
   s->run_for(10 * kMs);
   EXPECT_EQ(s->configuration(), "with_a");
   EXPECT_EQ(s->switches().size(), 40u);
-  ASSERT_TRUE(s->signal("robot", Signal::kOff).ok());  // off between two cycles
-  ASSERT_TRUE(s->signal("a", Signal::kOff).ok());      // and its producer, a release later at most
+  // The robot off between two cycles, then its producer: a runs on for the releases that come
+  // between the two, one when nothing holds this thread up, more when the machine stalls it (seen:
+  // 2 under a loaded ctest -j2), which is why the bound below counts the releases in between.
+  const std::int64_t off_from = s->now_ns();
+  ASSERT_TRUE(s->signal("robot", Signal::kOff).ok());
+  ASSERT_TRUE(s->signal("a", Signal::kOff).ok());
+  const auto releases_between = static_cast<std::uint64_t>((s->now_ns() - off_from) / (2 * kMs)) + 1;
   const auto robot = stats_of(*s, "robot");
   EXPECT_GT(robot.cycles, 50u);
   // Exactly one producer ran each of the robot's releases: no release went unproduced at a
   // switch, even one whose commit ran late (they are late too: late: run), and none twice.
   const std::uint64_t produced = stats_of(*s, "a").cycles + stats_of(*s, "b").cycles;
   EXPECT_LE(robot.cycles, produced) << "a release no producer ran";
-  EXPECT_LE(produced, robot.cycles + 1) << "a release two producers ran";
+  EXPECT_LE(produced, robot.cycles + releases_between) << "a release two producers ran";
   // How often the robot gave up waiting for a joining producer (at most half its deadline) is a
   // matter of timing: a loaded machine or a TSAN build gives 20 to 30 in 40 switches, as a broken
   // commit would. It is not asserted here (timing lives in bench/switch_bench.cpp); the virtual
