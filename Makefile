@@ -27,7 +27,7 @@ DEMO_CMD ?= scripts/demo.sh $(BUILD_DIR) 5
 FORMAT_DIRS := include src modules sim apps tests bench
 TIDY_DIRS ?= src modules sim apps
 
-.PHONY: help setup setup-lint setup-bench build build-bench test check fuzz demo bench bench-quick format format-check tidy clean
+.PHONY: help setup setup-lint setup-bench build build-bench test check fuzz demo bench bench-quick soak format format-check tidy clean
 
 help:
 	@echo "make demo          install missing packages, build, run the demo (DEMO_CMD)"
@@ -37,6 +37,7 @@ help:
 	@echo "make fuzz          build the libFuzzer targets ($(FUZZ_DIR)/, clang), fuzz each FUZZ_SECONDS=$(FUZZ_SECONDS) s; fails on any finding"
 	@echo "make bench         Release build in $(BENCH_DIR)/, run every benchmark (~5 min), write bench/results/latest.{json,md}"
 	@echo "make bench-quick   the same, short (under a minute once built); report in $(BENCH_DIR)/bench-results/quick/"
+	@echo "make soak          Figure 4 with its logger and the flight recorder for an hour (SOAK_SECONDS) on the real clock: memory, lost rows, misses; into the bench report"
 	@echo "make format        clang-format the sources in place; format-check only reports"
 	@echo "make tidy          clang-tidy over $(TIDY_DIRS)/ (fails on any finding)"
 	@echo "make setup         install the missing Debian packages (scripts/packages.txt)"
@@ -81,6 +82,13 @@ bench: build-bench
 
 bench-quick: build-bench
 	@bench/run.sh $(BENCH_DIR) --quick
+
+# Not run by CI (its short pass on the virtual clock is a test: tests/integration/soak). The result
+# goes into bench/results/soak.json and the benchmark report's "Soak" section.
+SOAK_SECONDS ?= 3600
+soak: build-bench
+	@/usr/bin/python3 bench/soak.py $(BENCH_DIR)/apps/chimera/chimera --seconds $(SOAK_SECONDS) --json bench/results/soak.json; \
+	  rc=$$?; /usr/bin/python3 bench/report.py bench/results/latest.json >/dev/null; exit $$rc
 
 # Sources to format: found on disk (not from git), so new files are included before they are committed.
 format_files = $(shell find $(FORMAT_DIRS) -type f \( -name '*.hpp' -o -name '*.cpp' -o -name '*.inl' -o -name '*.h' -o -name '*.cc' \) 2>/dev/null | sort)

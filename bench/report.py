@@ -130,6 +130,27 @@ def machine_lines(m):
     ]
 
 
+def soak_section(results_dir):
+    """The last `make soak` (bench/soak.py, soak.json beside this report): its own run, its own date."""
+    path = Path(results_dir) / "soak.json"
+    if not path.exists():
+        return []
+    r = json.loads(path.read_text())
+    hours = r["simulated_or_real_s"] / 3600
+    lines = ["## Soak", "",
+             f"`make soak` of {r.get('date', '?')} (commit `{r.get('commit', '?')}`), its own run: "
+             f"`{r['command']}`, {hours:.3g} h of Figure 4 on the {r['clock']} clock with its data logger and "
+             f"the flight recorder, memory sampled every {r['sample_every_s']:g} s. Machine: {r['machine']}.", "",
+             "| | |", "|---|---|",
+             f"| exit code | {r['exit_code']} |",
+             f"| memory (VmRSS) after the first tenth, at the end | {r['rss_kb_first_settled']} kB, {r['rss_kb_last']} kB |",
+             f"| memory growth | {r['memory_growth_kb']} kB (at most {r['max_growth_kb']} kB) |",
+             f"| logger rows, logger cycles, lost | {r['logger_rows']:,}, {r['logger_cycles']:,}, {r['lost_rows']} |",
+             f"| cycles run, deadlines missed | {sum(t['cycles'] for t in r['tasks'].values()):,}, {r['missed_deadlines']} |",
+             f"| verdict | {'passed' if not r['problems'] else '; '.join(r['problems'])} |", ""]
+    return lines
+
+
 def write_report(doc, samples, results_dir, name="latest"):
     results_dir = Path(results_dir)
     plots = {}
@@ -178,6 +199,8 @@ def write_report(doc, samples, results_dir, name="latest"):
     lines.append("")
 
     lines += analysis.sections(doc, plots)
+
+    lines += soak_section(results_dir)
 
     lines += ["## Every key", "", "| key | value | what |", "|---|---|---|"]
     for k in goals.KEYS:
