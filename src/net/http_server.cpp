@@ -161,7 +161,9 @@ int HttpServer::stream_connect(const mg_connection* conn, void* self) {
 void HttpServer::stream_ready(mg_connection* conn, void* self) {
   auto& server = *static_cast<HttpServer*>(self);
   server.streams_.fetch_add(1, std::memory_order_relaxed);
-  mg_set_user_connection_data(conn, new VariableStream(server.api_.gate(), conn));  // owned until stream_close
+  auto* stream = new VariableStream(server.api_.gate(), conn);  // NOLINT(cppcoreguidelines-owning-memory): see below
+  if (!stream->failure().empty()) spdlog::warn("network: a variable stream was refused: {}", stream->failure());
+  mg_set_user_connection_data(conn, stream);  // owned until stream_close
 }
 
 int HttpServer::stream_data(mg_connection* conn, int bits, char* data, std::size_t size, void* /*self*/) {

@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstring>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -35,7 +36,16 @@ VariableStream::VariableStream(ControlGate& gate, mg_connection* conn) : gate_(g
       },
       this);
   pthread_attr_destroy(&attributes);
-  started_ = failed == 0;  // without its thread the stream sends nothing; the client sees no ack
+  started_ = failed == 0;
+  // Without its thread the stream could send nothing: the client is told why, as the log is, and
+  // the stream is closed (the server's close callback then frees it as any other).
+  if (!started_) {
+    failure_ = fmt::format("no thread for this stream: {}", std::strerror(failed));
+    (void)send(error_text("unavailable", failure_));
+    mg_lock_connection(conn_);
+    (void)mg_websocket_write(conn_, MG_WEBSOCKET_OPCODE_CONNECTION_CLOSE, nullptr, 0);
+    mg_unlock_connection(conn_);
+  }
 }
 
 VariableStream::~VariableStream() {

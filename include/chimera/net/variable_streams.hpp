@@ -32,6 +32,10 @@ class VariableStream {
   VariableStream(const VariableStream&) = delete;
   VariableStream& operator=(const VariableStream&) = delete;
 
+  /// Why the stream could not start (its thread would not start): it has told the client and
+  /// sent the close frame. Empty when it runs.
+  [[nodiscard]] const std::string& failure() const { return failure_; }
+
   /// Handles one text frame from the client: {"variables": [...], "rate_hz": R}. The reply (an
   /// ack or an error) is sent by the stream's thread, the only writer. Not real-time safe.
   void receive(std::string_view text);
@@ -54,6 +58,7 @@ class VariableStream {
   // makes every new thread's whole stack resident, and 32 streams took 256 MiB that way.
   pthread_t thread_{};
   bool started_ = false;
+  std::string failure_;
 };
 
 }  // namespace chimera::net
