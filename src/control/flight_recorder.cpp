@@ -156,7 +156,7 @@ Result<void> FlightRecorder::write_timing(const std::string& path) const {
 }
 
 Result<void> FlightRecorder::dump(const std::string& dir, const std::string& why, std::int64_t now_ns,
-                                  const std::vector<std::string>& task_lines) const {
+                                  const std::vector<std::string>& task_lines, const std::string& subsystem_yaml) const {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) return make_error(Errc::kSystem, fmt::format("dump: cannot make the directory {}: {}", dir, ec.message()));
@@ -167,7 +167,10 @@ Result<void> FlightRecorder::dump(const std::string& dir, const std::string& why
                           "produced variable and of every task's cycles\n\n",
                           why, static_cast<double>(now_ns) / 1e9, seconds_));
   for (const auto& line : task_lines) summary.put(line + "\n");
-  return summary.close();
+  if (auto r = summary.close(); !r) return r;
+  OutFile spec(dir + "/subsystem.yaml");
+  spec.put(subsystem_yaml);
+  return spec.close();
 }
 
 }  // namespace chimera

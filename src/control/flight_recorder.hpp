@@ -40,10 +40,11 @@ class FlightRecorder {
   /// Writes what it holds into directory `dir` (made if missing; its files replaced):
   /// variables.csv (a data_logger log: t, then each element, one row per instant a variable was
   /// written, each variable's latest value at that instant), timing.csv (one row per cycle of
-  /// every task) and summary.txt (`why`, each task's state and last error, the window). `now_ns`
-  /// is the subsystem's time. Not real-time safe; the tasks run on meanwhile.
+  /// every task), summary.txt (`why`, each task's state and last error, the window) and
+  /// subsystem.yaml (`subsystem_yaml`: what ran, as `save` writes it). `now_ns` is the subsystem's
+  /// time. Not real-time safe; the tasks run on meanwhile.
   [[nodiscard]] Result<void> dump(const std::string& dir, const std::string& why, std::int64_t now_ns,
-                                  const std::vector<std::string>& task_lines) const;
+                                  const std::vector<std::string>& task_lines, const std::string& subsystem_yaml) const;
 
  private:
   struct RecordedVariable {

@@ -21,16 +21,6 @@ namespace chimera {
 
 namespace {
 
-// The subsystem as it stands: its tasks less the removed ones, the configuration on as `start`.
-SubsystemSpec live_spec(const Subsystem::Impl& m) {
-  SubsystemSpec out = m.spec;
-  out.tasks.clear();
-  for (std::size_t i = 0; i < m.spec.tasks.size(); ++i)
-    if (!m.is_removed(i)) out.tasks.push_back(m.spec.tasks[i]);
-  out.start = m.reconfiguration->configuration();
-  return out;
-}
-
 std::string live_task_names(const Subsystem::Impl& m) {
   std::vector<std::string> names;
   for (std::size_t i = 0; i < m.spec.tasks.size(); ++i)
@@ -81,6 +71,15 @@ Result<SubsystemSpec> with_task(const SubsystemSpec& current, std::string_view e
 
 }  // namespace
 
+SubsystemSpec Subsystem::Impl::live_spec() const {
+  SubsystemSpec out = spec;
+  out.tasks.clear();
+  for (std::size_t i = 0; i < spec.tasks.size(); ++i)
+    if (!is_removed(i)) out.tasks.push_back(spec.tasks[i]);
+  out.start = reconfiguration->configuration();
+  return out;
+}
+
 Result<std::string> Subsystem::add_task(std::string_view entry) {
   Impl& m = *impl_;
   while (!entry.empty() && entry.front() == ' ') entry.remove_prefix(1);
@@ -100,7 +99,7 @@ Result<std::string> Subsystem::add_task(std::string_view entry) {
     if (m.block)
       return make_error(Errc::kState, "add: not in a subsystem with module processes (process:): their workers "
                                       "run the tasks of the file as it was started");
-    current = live_spec(m);
+    current = m.live_spec();
   }
   auto next = with_task(current, entry, *m.registry);
   if (!next) return next.error();
@@ -250,7 +249,7 @@ Result<void> Subsystem::remove_task(std::string_view name) {
 Result<std::string> Subsystem::save_yaml() const {
   const Impl& m = *impl_;
   std::lock_guard<std::mutex> lock(m.ops_mutex);
-  const SubsystemSpec spec = live_spec(m);
+  const SubsystemSpec spec = m.live_spec();
   if (spec.tasks.empty()) return make_error(Errc::kState, "save: the subsystem has no task (a file has at least one)");
   for (const auto& c : spec.configurations) {
     const auto violations = verify_tasks(m.resolution.subsystem, c.tasks, {});

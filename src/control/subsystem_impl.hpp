@@ -87,6 +87,9 @@ struct Subsystem::Impl {
   /// The flight recorder's dump for each task that entered ERROR since the last call (each failure
   /// once), into options.error_dump_dir, announced by an event. From run_for's thread.
   void dump_new_errors();
+  /// The subsystem as it stands: its tasks less the removed ones, the configuration on as `start`.
+  /// From the thread that drives the commands, the only one that changes the spec.
+  [[nodiscard]] SubsystemSpec live_spec() const;
   /// Each task's state and last error, for a dump's summary.
   [[nodiscard]] std::vector<std::string> summary_lines() const;
   /// The fault lines of the current runtime's tasks (faults() adds the earlier ones).

@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include "chimera/config/spec_writer.hpp"
 #include "subsystem_impl.hpp"
 
 namespace chimera {
@@ -35,7 +36,7 @@ void Subsystem::Impl::dump_new_errors() {
     const std::string dir = fmt::format("{}/{}-{}-t{:.3f}s", options.error_dump_dir, spec.name, t.name(),
                                         static_cast<double>(failure.time_ns) / 1e9);
     const auto written = recorder->dump(dir, fmt::format("{} entered ERROR: {}", t.name(), failure.text), now,
-                                        summary_lines());
+                                        summary_lines(), write_subsystem_yaml(live_spec()));
     std::lock_guard<std::mutex> notes(notes_mutex);
     earlier_events.push_back(Event{now, t.name(),
                                    written ? fmt::format("flight recorder: the last {:.3g} s written to {}/",
@@ -55,7 +56,7 @@ Result<std::string> Subsystem::dump(const std::string& dir, std::string_view why
       !dir.empty() ? dir
                    : fmt::format("{}/{}-dump-t{:.3f}s", m.options.error_dump_dir.empty() ? "chimera-dumps" : m.options.error_dump_dir,
                                  m.spec.name, static_cast<double>(now) / 1e9);
-  if (auto written = m.recorder->dump(where, std::string(why), now, m.summary_lines()); !written) return written.error();
+  if (auto written = m.recorder->dump(where, std::string(why), now, m.summary_lines(), write_subsystem_yaml(m.live_spec())); !written) return written.error();
   return where;
 }
 

@@ -60,6 +60,11 @@ TEST(FlightRecorderCli, AHardTaskEnteringErrorDumpsTheLastSecondsByItself) {
   EXPECT_NE(summary.find("why: load entered ERROR"), std::string::npos) << summary;
   EXPECT_NE(summary.find("load: ERROR"), std::string::npos) << summary;
   EXPECT_NE(summary.find("traj: ON"), std::string::npos) << summary;
+  // What ran, as `save` writes it: a file `chimera verify` accepts, with the failed task in it.
+  const std::string ran = read_text(made + "/subsystem.yaml");
+  EXPECT_NE(ran.find("name: load"), std::string::npos) << ran;
+  const Outcome verified = run_chimera(dir, "verify " + quoted(made + "/subsystem.yaml"));
+  EXPECT_EQ(verified.exit_code, 0) << verified.out << verified.err;
   // 100 ms at 1 kHz: about 100 cycles of each of the three tasks, one of load's its missed one.
   const std::string timing = read_text(made + "/timing.csv");
   EXPECT_EQ(timing.rfind("task,t,latency_ns,exec_ns,response_ns,missed,overrun,failed,skipped\n", 0), 0U);
