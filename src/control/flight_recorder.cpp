@@ -8,6 +8,7 @@
 #include <system_error>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "chimera/svt/value_codec.hpp"
 
@@ -71,6 +72,13 @@ FlightRecorder::FlightRecorder(const ResolvedSubsystem& resolved, const GlobalTa
     for (const PortBinding& b : resolved.tasks[i].bindings)
       if (b.kind == PortKind::kOutVar)
         if (const auto v = table.find(b.variable)) var_hz[*v] = std::max(var_hz[*v], rate_hz(tasks[i]));
+
+  for (std::size_t i = 0; i < tasks.size(); ++i)
+    for (const PortBinding& b : resolved.tasks[i].bindings)
+      if (b.kind == PortKind::kOutConst)
+        if (const auto v = table.find(b.variable)) constants_.push_back(*v);
+  std::sort(constants_.begin(), constants_.end());
+  constants_.erase(std::unique(constants_.begin(), constants_.end()), constants_.end());
 
   const auto bytes_for = [&](double s) {
     std::size_t total = 0;
@@ -155,6 +163,20 @@ Result<void> FlightRecorder::write_timing(const std::string& path) const {
   return out.close();
 }
 
+Result<void> FlightRecorder::write_constants(const std::string& path) const {
+  OutFile out(path);
+  out.put("# The constants the tasks produced (out-consts), as they stood at the dump: a `constants:`\n"
+          "# map for a file that runs a task of this dump without their producers (log_player, docs/flight-recorder.md).\n"
+          "constants:\n");
+  for (const VarIndex v : constants_) {
+    const VarShape shape = table_.shape(v);
+    std::vector<std::byte> bytes(shape.bytes());
+    if (table_.read(v, bytes.data(), 0).freshness == Freshness::kNoData) continue;  // its producer never ran init
+    out.put(fmt::format("  {}: [{}]\n", table_.name(v), fmt::join(decode_values(shape, bytes.data()), ", ")));
+  }
+  return out.close();
+}
+
 Result<void> FlightRecorder::dump(const std::string& dir, const std::string& why, std::int64_t now_ns,
                                   const std::vector<std::string>& task_lines, const std::string& subsystem_yaml) const {
   std::error_code ec;
@@ -170,7 +192,8 @@ Result<void> FlightRecorder::dump(const std::string& dir, const std::string& why
   if (auto r = summary.close(); !r) return r;
   OutFile spec(dir + "/subsystem.yaml");
   spec.put(subsystem_yaml);
-  return spec.close();
+  if (auto r = spec.close(); !r) return r;
+  return write_constants(dir + "/constants.yaml");
 }
 
 }  // namespace chimera

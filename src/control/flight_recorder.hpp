@@ -40,8 +40,9 @@ class FlightRecorder {
   /// Writes what it holds into directory `dir` (made if missing; its files replaced):
   /// variables.csv (a data_logger log: t, then each element, one row per instant a variable was
   /// written, each variable's latest value at that instant), timing.csv (one row per cycle of
-  /// every task), summary.txt (`why`, each task's state and last error, the window) and
-  /// subsystem.yaml (`subsystem_yaml`: what ran, as `save` writes it). `now_ns` is the subsystem's
+  /// every task), summary.txt (`why`, each task's state and last error, the window),
+  /// subsystem.yaml (`subsystem_yaml`: what ran, as `save` writes it) and constants.yaml (the
+  /// values of the constants the tasks produced, as a file's `constants:` map). `now_ns` is the subsystem's
   /// time. Not real-time safe; the tasks run on meanwhile.
   [[nodiscard]] Result<void> dump(const std::string& dir, const std::string& why, std::int64_t now_ns,
                                   const std::vector<std::string>& task_lines, const std::string& subsystem_yaml) const;
@@ -53,6 +54,7 @@ class FlightRecorder {
   };
   Result<void> write_variables(const std::string& path) const;
   Result<void> write_timing(const std::string& path) const;
+  Result<void> write_constants(const std::string& path) const;
 
   const GlobalTable& table_;
   TaskSet& tasks_;
@@ -60,6 +62,7 @@ class FlightRecorder {
   std::vector<std::int32_t> ring_of_var_;   // per variable of the table, -1: not recorded
   std::vector<RecordedVariable> variables_;  // the recorded ones, in table order
   std::vector<std::int32_t> timing_ring_;   // per task
+  std::vector<VarIndex> constants_;         // the out-consts of the tasks, in table order
   double seconds_ = 0;
   bool shortened_ = false;
 };

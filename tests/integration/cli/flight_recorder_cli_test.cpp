@@ -65,6 +65,9 @@ TEST(FlightRecorderCli, AHardTaskEnteringErrorDumpsTheLastSecondsByItself) {
   EXPECT_NE(ran.find("name: load"), std::string::npos) << ran;
   const Outcome verified = run_chimera(dir, "verify " + quoted(made + "/subsystem.yaml"));
   EXPECT_EQ(verified.exit_code, 0) << verified.out << verified.err;
+  // The robot's ndof, which no ring records, as a file's constants: map.
+  const std::string constants = read_text(made + "/constants.yaml");
+  EXPECT_NE(constants.find("\nconstants:\n  ndof: [6]\n"), std::string::npos) << constants;
   // 100 ms at 1 kHz: about 100 cycles of each of the three tasks, one of load's its missed one.
   const std::string timing = read_text(made + "/timing.csv");
   EXPECT_EQ(timing.rfind("task,t,latency_ns,exec_ns,response_ns,missed,overrun,failed,skipped\n", 0), 0U);
