@@ -89,6 +89,15 @@ struct PlotArgs {
   std::string variables;              // comma-separated; empty: all
   std::string title;
 };
+struct ReplayArgs {
+  std::string dump;  // a flight-recorder dump's directory
+  std::string task;
+};
+
+/// `chimera replay DUMP --task NAME`: the task run on its recorded inputs on the virtual clock,
+/// its outputs compared with the recorded ones. Exit 1 if it entered ERROR, 2 on bad input.
+int replay_command(const ReplayArgs& args);
+
 /// `chimera plot LOG.csv [-o OUT.png] [--vars a,b] [--title TEXT]`; returns the exit code.
 int plot_command(const PlotArgs& args);
 

@@ -120,6 +120,12 @@ int run_main(int argc, char** argv) {
   plot_cmd->add_option("--vars", plot.variables, "only these variables, comma-separated");
   plot_cmd->add_option("--title", plot.title, "the picture's title (default: the log's file name)");
 
+  chimera::cli::ReplayArgs replay;
+  auto* replay_cmd = app.add_subcommand(
+      "replay", "Run one task of a flight-recorder dump on its recorded inputs (virtual clock) and compare its outputs");
+  replay_cmd->add_option("DUMP", replay.dump, "a dump's directory (variables.csv, subsystem.yaml, ...)")->required();
+  replay_cmd->add_option("--task", replay.task, "the task to run")->required();
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -144,6 +150,7 @@ int run_main(int argc, char** argv) {
     return chimera::cli::run_command(run);
   }
   if (serve_cmd->parsed()) return chimera::cli::run_command(serve);
+  if (replay_cmd->parsed()) return chimera::cli::replay_command(replay);
   if (plot_cmd->parsed()) {
     if (plot_output_opt->count() > 0) plot.output = plot_output;
     return chimera::cli::plot_command(plot);

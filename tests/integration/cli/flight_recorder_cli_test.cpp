@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
 
 #include "run_chimera.hpp"
 
@@ -108,6 +109,54 @@ TEST(FlightRecorderCli, WithTheRecorderOffDumpIsRefusedAndNothingIsWritten) {
   EXPECT_NE((o.out + o.err).find("dump: this run keeps no history (the flight recorder is off)"), std::string::npos)
       << o.out << o.err;
   EXPECT_FALSE(fs::exists(dir.file("dumps")));
+}
+
+// chimera replay: the task that entered ERROR, run again on its recorded inputs, enters it again
+// at the same recorded release (cpu_load's 200th cycle overruns whatever its inputs; the dump's
+// name says when the original did: -load-t0.201s).
+TEST(FlightRecorderCli, ReplayBringsBackAFaultOfTheModuleAtItsRecordedRelease) {
+  TempDir dir;
+  const std::string file = subsystem_file(dir);
+  const std::string dumps = dir.file("dumps");
+  const Outcome o = run_chimera(dir, "run " + quoted(file) + " --clock virtual --for 500ms --record 300ms --dump-dir " +
+                                         quoted(dumps));
+  ASSERT_EQ(o.exit_code, 1) << o.err;
+  std::string made;
+  for (const auto& entry : fs::directory_iterator(dumps)) made = entry.path().string();
+  const Outcome replayed = run_chimera(dir, "replay " + quoted(std::as_const(made)) + " --task load");
+  EXPECT_EQ(replayed.exit_code, 1) << replayed.out << replayed.err;
+  EXPECT_NE(replayed.out.find("replay: 'load' entered ERROR at the recorded t = 0.201"), std::string::npos)
+      << replayed.out << replayed.err;
+  const Outcome missing = run_chimera(dir, "replay " + quoted(std::as_const(made)) + " --task nosuch");
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_NE(missing.err.find("no task named 'nosuch' in the dump"), std::string::npos) << missing.err;
+}
+
+// A module without state of its own (forward kinematics) replayed on its recorded theta_m gives
+// back its recorded x_m to within what one release's order changes (the original fk may have
+// read the robot's theta_m of the release before; the player gives it the one of its release).
+TEST(FlightRecorderCli, ReplayComparesATasksOutputsWithTheRecordedOnes) {
+  TempDir dir;
+  const std::string file = dir.file("fk.yaml");
+  write_text(file, "subsystem: replay_fk_" + std::to_string(::getpid()) +
+                       "\ntasks:\n"
+                       "  - {name: traj, module: joint_traj_gen, period: 1ms}\n"
+                       "  - {name: robot, module: robot_position, period: 1ms}\n"
+                       "  - {name: fk, module: fwd_kin_jacobian, period: 1ms}\n");
+  const std::string dumps = dir.file("dumps");
+  const Outcome o = run_chimera(dir, "run " + quoted(file) + " --clock virtual --for 1s --record 300ms --dump-at-exit --dump-dir " +
+                                         quoted(dumps));
+  ASSERT_EQ(o.exit_code, 0) << o.err;
+  std::string made;
+  for (const auto& entry : fs::directory_iterator(dumps)) made = entry.path().string();
+  const Outcome replayed = run_chimera(dir, "replay " + quoted(std::as_const(made)) + " --task fk");
+  EXPECT_EQ(replayed.exit_code, 0) << replayed.out << replayed.err;
+  EXPECT_NE(replayed.out.find("301 releases from t = 0.699 s, its inputs theta_m"), std::string::npos) << replayed.out;
+  const auto at = replayed.out.find("x_m: at most ");
+  ASSERT_NE(at, std::string::npos) << replayed.out;
+  EXPECT_LT(std::stod(replayed.out.substr(at + 13)), 0.01) << replayed.out;
+  EXPECT_NE(replayed.out.find("over 301 releases"), std::string::npos) << replayed.out;
+  EXPECT_NE(replayed.out.find("replay: 'fk' ran every release without a fault"), std::string::npos) << replayed.out;
 }
 
 }  // namespace
