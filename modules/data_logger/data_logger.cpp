@@ -53,12 +53,8 @@ StringList variables_of(const Params& p) {
 
 // Where the CSV goes: `file`, or <task>.csv; a relative path below $CHIMERA_LOG_DIR if it is set.
 std::string log_path(const Params& p, std::string_view task) {
-  std::filesystem::path file = p.text("file");
-  if (file.empty()) file = std::string(task) + ".csv";
-  // NOLINTNEXTLINE(concurrency-mt-unsafe): read in init; nothing in chimera changes the environment
-  const char* dir = std::getenv("CHIMERA_LOG_DIR");
-  if (file.is_relative() && dir != nullptr && *dir != '\0') file = std::filesystem::path(dir) / file;
-  return file.string();
+  const std::string file = p.text("file");
+  return log_file_path(file.empty() ? std::string(task) + ".csv" : file);
 }
 
 // The writer is an ordinary thread, whatever the task's thread is: it must not inherit SCHED_FIFO

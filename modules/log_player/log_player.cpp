@@ -23,15 +23,6 @@ namespace {
 // A log is read whole in init: a bound on it keeps a wrong file from taking the machine's memory.
 constexpr std::uintmax_t kMostFileBytes = std::uintmax_t{512} << 20;
 
-// `file`; a relative path below $CHIMERA_LOG_DIR if it is set, as data_logger writes it.
-std::string log_path(const Params& p) {
-  std::filesystem::path file = p.text("file");
-  // NOLINTNEXTLINE(concurrency-mt-unsafe): read in init; nothing in chimera changes the environment
-  const char* dir = std::getenv("CHIMERA_LOG_DIR");
-  if (file.is_relative() && dir != nullptr && *dir != '\0') file = std::filesystem::path(dir) / file;
-  return file.string();
-}
-
 std::vector<std::string> split(const std::string& line) {
   std::vector<std::string> cells;
   std::size_t from = 0;
@@ -63,7 +54,7 @@ class LogPlayer final : public Module {
     if (names.empty()) return Status::fail("give variables: [names] to play");
     for (const auto& name : names) outs_.push_back(ctx.out<double>(name));
     if (ctx.failed()) return Status::ok();  // an unbound view already fails init, naming the port
-    path_ = log_path(ctx.params());
+    path_ = log_file_path(ctx.params().text("file"));  // where data_logger writes it
     from_s_ = ctx.params().number("from", 0.0);
     timing_ = &ctx.timing();
     return read_log(names);

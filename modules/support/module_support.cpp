@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
 #include <mutex>
 #include <set>
 
@@ -23,6 +25,14 @@ Vector per_joint(const Params& p, std::string_view name, Vector fallback, std::s
 
 bool all_non_negative(const Vector& v) {
   return std::all_of(v.begin(), v.end(), [](double x) { return x >= 0.0; });
+}
+
+std::string log_file_path(const std::string& file) {
+  std::filesystem::path path = file;
+  // NOLINTNEXTLINE(concurrency-mt-unsafe): read in init; nothing in chimera changes the environment
+  const char* dir = std::getenv("CHIMERA_LOG_DIR");
+  if (path.is_relative() && dir != nullptr && *dir != '\0') path = std::filesystem::path(dir) / path;
+  return path.string();
 }
 
 }  // namespace chimera::modules

@@ -20,4 +20,8 @@ Vector per_joint(const Params& p, std::string_view name, Vector fallback, std::s
 /// Whether every value is >= 0 (per_joint() leaves the sign to the caller).
 bool all_non_negative(const Vector& v);
 
+/// Where a log file of a module is: `file` itself, or below $CHIMERA_LOG_DIR (when it is set) if
+/// `file` is relative. data_logger writes there and log_player reads there.
+std::string log_file_path(const std::string& file);
+
 }  // namespace chimera::modules
