@@ -138,15 +138,16 @@ def soak_section(results_dir):
     r = json.loads(path.read_text())
     hours = r["simulated_or_real_s"] / 3600
     lines = ["## Soak", "",
-             f"`make soak` of {r.get('date', '?')} (commit `{r.get('commit', '?')}`), its own run: "
+             f"The soak (`bench/soak.py`, `make soak`) of {r.get('date', '?')} (commit `{r.get('commit', '?')}`), its own run: "
              f"`{r['command']}`, {hours:.3g} h of Figure 4 on the {r['clock']} clock with its data logger and "
-             f"the flight recorder, memory sampled every {r['sample_every_s']:g} s. Machine: {r['machine']}.", "",
+             f"the flight recorder, memory sampled every {r['sample_every_s']:g} s. Machine: {r['machine']}."
+             + (f" {r['note']}" if r.get("note") else ""), "",
              "| | |", "|---|---|",
              f"| exit code | {r['exit_code']} |",
              f"| memory (VmRSS) after the first tenth, at the end | {r['rss_kb_first_settled']} kB, {r['rss_kb_last']} kB |",
              f"| memory growth | {r['memory_growth_kb']} kB (at most {r['max_growth_kb']} kB) |",
              f"| logger rows, logger cycles, lost | {r['logger_rows']:,}, {r['logger_cycles']:,}, {r['lost_rows']} |",
-             f"| cycles run, deadlines missed | {sum(t['cycles'] for t in r['tasks'].values()):,}, {r['missed_deadlines']} |",
+             f"| cycles run, deadlines missed | {sum(t['cycles'] for t in r['tasks'].values()):,}, {r['missed_deadlines']:,} |",
              f"| verdict | {'passed' if not r['problems'] else '; '.join(r['problems'])} |", ""]
     return lines
 

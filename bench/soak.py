@@ -106,13 +106,16 @@ def main():
     p.add_argument("--clock", choices=["real", "virtual"], default="real")
     p.add_argument("--json", type=Path, help="write the result here")
     p.add_argument("--max-growth-kb", type=int, default=1024)
+    p.add_argument("--note", default="", help="what else the machine did meanwhile, for the report")
     args = p.parse_args()
 
+    # The commit when it starts: the tree may move on during an hour's run.
+    commit = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True, text=True)
     with tempfile.TemporaryDirectory(prefix="chimera-soak-") as tmp:
         r = soak(args.chimera.resolve(), args.seconds, args.sample, args.clock, Path(tmp))
     r["max_growth_kb"] = args.max_growth_kb
+    r["note"] = args.note
     r["date"] = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
-    commit = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True, text=True)
     r["commit"] = commit.stdout.strip() if commit.returncode == 0 else None
     problems = []
     if r["exit_code"] != 0:
