@@ -45,12 +45,12 @@ class OutFile {
     if (file_ != nullptr && std::fwrite(text.data(), 1, text.size(), file_) != text.size()) failed_ = errno;
   }
   Result<void> close() {
-    if (file_ == nullptr) return make_error(Errc::kSystem, fmt::format("dump: cannot write {}: {}", path_, std::strerror(errno)));
+    if (file_ == nullptr) return make_error(Errc::kSystem, fmt::format("dump: cannot write {}: {}", path_, std::generic_category().message(errno)));
     const int closed = std::fclose(file_) == 0 ? 0 : errno;
     file_ = nullptr;
     if (failed_ != 0 || closed != 0)
       return make_error(Errc::kSystem,
-                        fmt::format("dump: cannot write {}: {}", path_, std::strerror(failed_ != 0 ? failed_ : closed)));
+                        fmt::format("dump: cannot write {}: {}", path_, std::generic_category().message(failed_ != 0 ? failed_ : closed)));
     return {};
   }
 
@@ -59,6 +59,18 @@ class OutFile {
   std::FILE* file_;
   int failed_ = 0;
 };
+
+// The variables the tasks' out-consts produce, in table order, each once.
+std::vector<VarIndex> produced_constants(const ResolvedSubsystem& resolved, const GlobalTable& table) {
+  std::vector<VarIndex> out;
+  for (const ResolvedTask& t : resolved.tasks)
+    for (const PortBinding& b : t.bindings)
+      if (b.kind == PortKind::kOutConst)
+        if (const auto v = table.find(b.variable)) out.push_back(*v);
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
 
 }  // namespace
 
@@ -73,13 +85,7 @@ FlightRecorder::FlightRecorder(const ResolvedSubsystem& resolved, const GlobalTa
       if (b.kind == PortKind::kOutVar)
         if (const auto v = table.find(b.variable)) var_hz[*v] = std::max(var_hz[*v], rate_hz(tasks[i]));
 
-  for (std::size_t i = 0; i < tasks.size(); ++i)
-    for (const PortBinding& b : resolved.tasks[i].bindings)
-      if (b.kind == PortKind::kOutConst)
-        if (const auto v = table.find(b.variable)) constants_.push_back(*v);
-  std::sort(constants_.begin(), constants_.end());
-  constants_.erase(std::unique(constants_.begin(), constants_.end()), constants_.end());
-
+  constants_ = produced_constants(resolved, table);
   const auto bytes_for = [&](double s) {
     std::size_t total = 0;
     for (std::size_t v = 0; v < var_hz.size(); ++v)

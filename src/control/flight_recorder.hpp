@@ -31,6 +31,9 @@ class FlightRecorder {
   FlightRecorder(const ResolvedSubsystem& resolved, const GlobalTable& table, TaskSet& tasks, double seconds);
   FlightRecorder(const FlightRecorder&) = delete;
   FlightRecorder& operator=(const FlightRecorder&) = delete;
+  FlightRecorder(FlightRecorder&&) = delete;
+  FlightRecorder& operator=(FlightRecorder&&) = delete;
+  ~FlightRecorder() = default;
 
   /// How much history it keeps (seconds of the fastest producer), and its memory.
   [[nodiscard]] double seconds() const noexcept { return seconds_; }

@@ -31,6 +31,7 @@ std::size_t HistoryRings::add(std::uint32_t capacity, std::uint32_t payload_byte
 
 void HistoryRings::allocate() {
   CHIMERA_INVARIANT(block_ == nullptr, "the block allocated twice");
+  // NOLINTNEXTLINE(cppcoreguidelines-avoid-c-arrays): one block of a size known only now, never resized
   block_ = std::make_unique<std::uint64_t[]>(words_);  // value-initialised: every word 0
 }
 

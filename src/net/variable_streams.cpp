@@ -4,7 +4,7 @@
 
 #include <chrono>
 #include <cmath>
-#include <cstring>
+#include <system_error>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -40,7 +40,7 @@ VariableStream::VariableStream(ControlGate& gate, mg_connection* conn) : gate_(g
   // Without its thread the stream could send nothing: the client is told why, as the log is, and
   // the stream is closed (the server's close callback then frees it as any other).
   if (!started_) {
-    failure_ = fmt::format("no thread for this stream: {}", std::strerror(failed));
+    failure_ = fmt::format("no thread for this stream: {}", std::generic_category().message(failed));
     (void)send(error_text("unavailable", failure_));
     mg_lock_connection(conn_);
     (void)mg_websocket_write(conn_, MG_WEBSOCKET_OPCODE_CONNECTION_CLOSE, nullptr, 0);
