@@ -9,7 +9,6 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
-#include <utility>
 
 #include "run_chimera.hpp"
 
@@ -44,6 +43,14 @@ std::size_t lines_of(const std::string& path) {
   return n;
 }
 
+// The one dump directory the run made below `dumps` ("" if none).
+std::string the_dump(const std::string& dumps) {
+  std::string made;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dumps, ec)) made = entry.path().string();
+  return made;
+}
+
 TEST(FlightRecorderCli, AHardTaskEnteringErrorDumpsTheLastSecondsByItself) {
   TempDir dir;
   const std::string file = subsystem_file(dir);
@@ -52,8 +59,7 @@ TEST(FlightRecorderCli, AHardTaskEnteringErrorDumpsTheLastSecondsByItself) {
                                          quoted(dumps));
   EXPECT_EQ(o.exit_code, 1) << o.err;  // a hard task failed
   ASSERT_TRUE(fs::is_directory(dumps)) << o.err;
-  std::string made;
-  for (const auto& entry : fs::directory_iterator(dumps)) made = entry.path().string();
+  const std::string made = the_dump(dumps);
   ASSERT_FALSE(made.empty());
   EXPECT_NE(made.find("-load-t"), std::string::npos) << made;
   EXPECT_NE(o.err.find("load: flight recorder: the last 0.1 s written to " + made + "/"), std::string::npos) << o.err;
@@ -121,13 +127,13 @@ TEST(FlightRecorderCli, ReplayBringsBackAFaultOfTheModuleAtItsRecordedRelease) {
   const Outcome o = run_chimera(dir, "run " + quoted(file) + " --clock virtual --for 500ms --record 300ms --dump-dir " +
                                          quoted(dumps));
   ASSERT_EQ(o.exit_code, 1) << o.err;
-  std::string made;
-  for (const auto& entry : fs::directory_iterator(dumps)) made = entry.path().string();
-  const Outcome replayed = run_chimera(dir, "replay " + quoted(std::as_const(made)) + " --task load");
+  const std::string made = the_dump(dumps);
+  ASSERT_FALSE(made.empty()) << o.err;
+  const Outcome replayed = run_chimera(dir, "replay " + quoted(made) + " --task load");
   EXPECT_EQ(replayed.exit_code, 1) << replayed.out << replayed.err;
   EXPECT_NE(replayed.out.find("replay: 'load' entered ERROR at the recorded t = 0.201"), std::string::npos)
       << replayed.out << replayed.err;
-  const Outcome missing = run_chimera(dir, "replay " + quoted(std::as_const(made)) + " --task nosuch");
+  const Outcome missing = run_chimera(dir, "replay " + quoted(made) + " --task nosuch");
   EXPECT_EQ(missing.exit_code, 2);
   EXPECT_NE(missing.err.find("no task named 'nosuch' in the dump"), std::string::npos) << missing.err;
 }
@@ -147,9 +153,9 @@ TEST(FlightRecorderCli, ReplayComparesATasksOutputsWithTheRecordedOnes) {
   const Outcome o = run_chimera(dir, "run " + quoted(file) + " --clock virtual --for 1s --record 300ms --dump-at-exit --dump-dir " +
                                          quoted(dumps));
   ASSERT_EQ(o.exit_code, 0) << o.err;
-  std::string made;
-  for (const auto& entry : fs::directory_iterator(dumps)) made = entry.path().string();
-  const Outcome replayed = run_chimera(dir, "replay " + quoted(std::as_const(made)) + " --task fk");
+  const std::string made = the_dump(dumps);
+  ASSERT_FALSE(made.empty()) << o.err;
+  const Outcome replayed = run_chimera(dir, "replay " + quoted(made) + " --task fk");
   EXPECT_EQ(replayed.exit_code, 0) << replayed.out << replayed.err;
   EXPECT_NE(replayed.out.find("301 releases from t = 0.699 s, its inputs theta_m"), std::string::npos) << replayed.out;
   const auto at = replayed.out.find("x_m: at most ");
