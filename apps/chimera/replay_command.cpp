@@ -91,12 +91,14 @@ TaskPorts ports_of(const ResolvedTask& task, const ResolvedSubsystem& resolved, 
   try {
     YAML::Node dumped;
     std::error_code ec;
-    if (fs::is_regular_file(dump + "/constants.yaml", ec)) dumped = YAML::LoadFile(dump + "/constants.yaml")["constants"];
+    if (fs::is_regular_file(dump + "/constants.yaml", ec))
+      dumped = YAML::LoadFile(dump + "/constants.yaml")["constants"];
     for (const PortBinding& b : task.bindings) {
       if (b.kind == PortKind::kOutVar && has_column(recorded, b.variable)) ports.outputs.push_back(b.variable);
       if (b.kind == PortKind::kInVar) {
         if (!has_column(recorded, b.variable)) {
-          ports.problem = fmt::format("'{}' reads {}, which the dump does not hold (no task produced it)", name, b.variable);
+          ports.problem =
+              fmt::format("'{}' reads {}, which the dump does not hold (no task produced it)", name, b.variable);
           return ports;
         }
         ports.inputs.push_back(b.variable);
@@ -204,7 +206,8 @@ int replay_command(const ReplayArgs& args) {
   const std::string variables_csv = dump + "/variables.csv";
   std::error_code ec;
   if (!fs::is_regular_file(dump + "/subsystem.yaml", ec))
-    return fail(fmt::format("{}: no subsystem.yaml: not a flight-recorder dump (or one from before it was written)", dump));
+    return fail(
+        fmt::format("{}: no subsystem.yaml: not a flight-recorder dump (or one from before it was written)", dump));
   auto original = load_file(dump + "/subsystem.yaml", std::nullopt);
   if (!original) return kExitInvalid;
   const auto recorded = read_recorded(variables_csv);
@@ -232,8 +235,9 @@ int replay_command(const ReplayArgs& args) {
 
   fmt::print("replay: task '{}' ({}) of {}, on the virtual clock: {} releases from t = {} s, {}\n", args.task,
              task->spec->module, dump, c.ran, from_s,
-             ports.inputs.empty() ? std::string("a task that reads no variable")
-                                  : fmt::format("its inputs {} played from variables.csv", fmt::join(ports.inputs, ", ")));
+             ports.inputs.empty()
+                 ? std::string("a task that reads no variable")
+                 : fmt::format("its inputs {} played from variables.csv", fmt::join(ports.inputs, ", ")));
   for (const auto& out : ports.outputs) {
     const double worst = c.worst.contains(out) ? c.worst.at(out) : 0.0;
     fmt::print("  {}: at most {:.6g} from the recorded over {} releases{}\n", out, worst, c.compared,

@@ -41,7 +41,8 @@ class LogPlayer final : public Module {
   static constexpr const char* kDoc = docs::log_player::kText;
 
   static void declare(Declarations& d, const Params& p) {
-    for (const auto& v : p.strings("variables")) d.out_var(v, Dim::follow(), "the log's columns v[0], v[1], ... each row");
+    for (const auto& v : p.strings("variables"))
+      d.out_var(v, Dim::follow(), "the log's columns v[0], v[1], ... each row");
     d.param("variables", StringList{}, "", "state variables to play (one out-var port each), columns of the log");
     d.param("file", std::string(), "", "the log (CSV, header t,v[0],...); relative: below $CHIMERA_LOG_DIR if set");
     d.param("from", 0.0, "s", "the log's time played at the subsystem's time 0");
@@ -53,7 +54,7 @@ class LogPlayer final : public Module {
     const auto names = ctx.params().strings("variables");
     if (names.empty()) return Status::fail("give variables: [names] to play");
     for (const auto& name : names) outs_.push_back(ctx.out<double>(name));
-    if (ctx.failed()) return Status::ok();  // an unbound view already fails init, naming the port
+    if (ctx.failed()) return Status::ok();             // an unbound view already fails init, naming the port
     path_ = log_file_path(ctx.params().text("file"));  // where data_logger writes it
     from_s_ = ctx.params().number("from", 0.0);
     timing_ = &ctx.timing();
@@ -87,7 +88,8 @@ class LogPlayer final : public Module {
     if (ec || !std::filesystem::is_regular_file(path_, ec))
       return Status::fail(intern(fmt::format("{}: cannot read the log: {}", path_, ec ? ec.message() : "not a file")));
     if (bytes > kMostFileBytes)
-      return Status::fail(intern(fmt::format("{}: {} bytes, over the {} MiB a log may have", path_, bytes, kMostFileBytes >> 20)));
+      return Status::fail(
+          intern(fmt::format("{}: {} bytes, over the {} MiB a log may have", path_, bytes, kMostFileBytes >> 20)));
     std::ifstream in(path_);
     std::string line;
     if (!std::getline(in, line)) return Status::fail(intern(fmt::format("{}:1: the file is empty", path_)));
@@ -101,8 +103,8 @@ class LogPlayer final : public Module {
         std::size_t at = 0;
         while (at < header.size() && header[at] != want) ++at;
         if (at == header.size())
-          return Status::fail(intern(fmt::format("{}:1: no column {} ({} has {} elements here)", path_, want, names[v],
-                                                 outs_[v].size())));
+          return Status::fail(intern(
+              fmt::format("{}:1: no column {} ({} has {} elements here)", path_, want, names[v], outs_[v].size())));
         columns.push_back(at);
       }
     width_ = columns.size();
@@ -110,7 +112,8 @@ class LogPlayer final : public Module {
       if (line.empty()) continue;
       const auto cells = split(line);
       if (cells.size() != header.size())
-        return Status::fail(intern(fmt::format("{}:{}: {} cells, the header has {}", path_, number, cells.size(), header.size())));
+        return Status::fail(
+            intern(fmt::format("{}:{}: {} cells, the header has {}", path_, number, cells.size(), header.size())));
       const auto number_of = [&](const std::string& cell, double& out) {
         char* end = nullptr;
         errno = 0;
@@ -119,12 +122,14 @@ class LogPlayer final : public Module {
       };
       double t = 0;
       if (!number_of(cells[0], t) || (!times_.empty() && t < times_.back()))
-        return Status::fail(intern(fmt::format("{}:{}: t is '{}', not a time at or after the row before", path_, number, cells[0])));
+        return Status::fail(
+            intern(fmt::format("{}:{}: t is '{}', not a time at or after the row before", path_, number, cells[0])));
       times_.push_back(t);
       for (const std::size_t c : columns) {
         double value = 0;
         if (!number_of(cells[c], value))
-          return Status::fail(intern(fmt::format("{}:{}: '{}' in column {} is not a number", path_, number, cells[c], header[c])));
+          return Status::fail(
+              intern(fmt::format("{}:{}: '{}' in column {} is not a number", path_, number, cells[c], header[c])));
         rows_.push_back(value);
       }
     }

@@ -17,7 +17,8 @@ namespace {
 
 // A log in the temporary folder, unique to this process and `tag`.
 std::string write_log(const std::string& tag, const std::string& text) {
-  const auto path = std::filesystem::temp_directory_path() / ("log_player_" + std::to_string(::getpid()) + "_" + tag + ".csv");
+  const auto path =
+      std::filesystem::temp_directory_path() / ("log_player_" + std::to_string(::getpid()) + "_" + tag + ".csv");
   std::ofstream(path) << text;
   return path.string();
 }
@@ -65,7 +66,8 @@ TEST(LogPlayer, RefusesWhatIsNotAPlayableLogNamingTheFileAndLine) {
   EXPECT_NE(start_error(player_file(missing_column)).find(missing_column + ":1: no column u[1]"), std::string::npos)
       << start_error(player_file(missing_column));
   const std::string bad_cell = write_log("cell", "t,u[0],u[1]\n0,1,2\n0.001,x,2\n");
-  EXPECT_NE(start_error(player_file(bad_cell)).find(bad_cell + ":3: 'x' in column u[0] is not a number"), std::string::npos)
+  EXPECT_NE(start_error(player_file(bad_cell)).find(bad_cell + ":3: 'x' in column u[0] is not a number"),
+            std::string::npos)
       << start_error(player_file(bad_cell));
   const std::string backwards = write_log("back", "t,u[0],u[1]\n0.002,1,2\n0.001,1,2\n");
   EXPECT_NE(start_error(player_file(backwards)).find(backwards + ":3: t is"), std::string::npos);
