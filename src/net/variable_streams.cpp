@@ -141,9 +141,11 @@ void VariableStream::run() {
     const bool ok = send(frame);  // blocks only this thread when the client reads slowly
     lock.lock();
     if (!ok) return;
-    // The next sample on the rate's grid; a client that took longer skips the samples it missed.
+    // The next sample on the rate's grid: a client that took longer, or a thread woken late,
+    // skips the grid points it missed rather than sending them in a burst, so two samples are
+    // never closer than the grid allows after the first.
     next += period;
-    if (const auto now = Clock::now(); next < now) next = now;
+    if (const auto now = Clock::now(); next < now) next += period * ((now - next) / period + 1);
   }
 }
 
