@@ -37,7 +37,7 @@ stages=("$@")
 san_build=(-DCMAKE_BUILD_TYPE=Debug "-DCMAKE_C_FLAGS_DEBUG=-g1 -O1" "-DCMAKE_CXX_FLAGS_DEBUG=-g1 -O1"
   -DCHIMERA_WERROR=OFF)
 
-declare -A build_status test_summary stage_time failed_tests
+declare -A build_status test_summary stage_time failed_tests BUILD_DIRS
 total_passed=0
 total_failed=0
 any_failed=0
@@ -50,6 +50,7 @@ run_stage() {
   read -r -a ctest_args <<<"$4"
   shift 4
   local start=${SECONDS}
+  BUILD_DIRS[${name}]="${dir}"
   echo
   echo "=== ${name}: build ${dir}"
   (
@@ -157,6 +158,9 @@ for stage in "${stages[@]}"; do
   [[ -n "${failed_tests[${stage}]:-}" ]] || continue
   echo "  failed in ${stage}:"
   sed 's/^/    /' <<<"${failed_tests[${stage}]}"
+  # And what they said: GoogleTest's "FILE:LINE: Failure" lines with the few after each, so that
+  # a failure seen once in CI can be read without the middle of the log.
+  grep -E -A4 ': Failure$' "${BUILD_DIRS[${stage}]}/chimera-ctest.log" 2>/dev/null | head -n 40 | sed 's/^/      | /'
 done
 # The closing line counts the tests of all trees; a tree that did not build counts as one failure.
 echo "chimera: ${total_passed} passed, ${total_failed} failed"
