@@ -72,8 +72,8 @@ Result<void> check_writable(const std::string& path) {
 /// The loop between start and stop: commands in, replies and events out, time kept.
 class Session {
  public:
-  Session(Subsystem& subsystem, net::ControlGate& control, const RunArgs& args, bool interactive)
-      : subsystem_(subsystem), control_(control), args_(args), interactive_(interactive) {}
+  Session(Subsystem& subsystem, net::ControlGate& control, RemotePorts* remote, const RunArgs& args, bool interactive)
+      : subsystem_(subsystem), control_(control), remote_(remote), args_(args), interactive_(interactive) {}
 
   void run() {
     LineReader reader(STDIN_FILENO);
@@ -129,7 +129,12 @@ class Session {
   [[nodiscard]] bool should_end() const { return stop_requested() || time_up(); }
 
   void print_events(bool& prompt_shown) {
-    const std::string events = control_.drain_events();
+    std::string events = control_.drain_events();
+    // The bridge's news among the subsystem's own: an import stale or back, a remote refused.
+    if (remote_ != nullptr) {
+      for (const auto& line : remote_->take_errors()) events += "dds: " + line + "\n";
+      for (const auto& line : remote_->take_changes()) events += "dds: " + line + "\n";
+    }
     if (events.empty()) return;
     // Keep the operator's prompt usable: events go on their own lines, then the prompt again.
     if (prompt_shown) out("\n");
@@ -161,6 +166,7 @@ class Session {
 
   Subsystem& subsystem_;
   net::ControlGate& control_;  // shared with the network API
+  RemotePorts* remote_;        // the bridge to other subsystems, or none
   const RunArgs& args_;
   bool interactive_;
 };
@@ -240,11 +246,11 @@ int run_command(const RunArgs& args) {
     }
     network = std::move(*started);
   }
-  Session session(subsystem, gate, args, interactive);
+  Session session(subsystem, gate, remote.get(), args, interactive);
   session.run();
   network.reset();  // the network API ends before the subsystem stops
   if (remote) {
-    for (const auto& line : remote->take_errors()) err(line + "\n");
+    for (const auto& line : remote->take_errors()) err("dds: " + line + "\n");
     remote.reset();  // the bridge stops writing imports before the tasks stop
   }
 

@@ -56,7 +56,13 @@ Reply Control::execute(const Command& command) {
   // A fault inside the Subsystem must not take the shell down with it; the operator reads it.
   try {
     switch (command.verb) {
-      case Verb::kStatus: return said(status_table(subsystem_.snapshot()));
+      case Verb::kStatus: {
+        std::string text = status_table(subsystem_.snapshot());
+        // The flag is what makes the robot interfaces hold the arm (paper 3.4): say when it is up.
+        if (subsystem_.illegal_configuration())
+          text += "illegal-configuration flag raised: the robot interfaces hold the arm\n";
+        return said(std::move(text));
+      }
       case Verb::kStats: {
         const auto tasks = subsystem_.snapshot();
         if (command.args.empty()) return said(timing_table(tasks));

@@ -5,8 +5,6 @@
 
 #include "chimera/dds/remote_ports.hpp"
 
-#include <dds/dds.h>
-
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -16,8 +14,10 @@
 #include <set>
 #include <thread>
 
+#include <dds/dds.h>
 #include <fmt/format.h>
 
+#include "chimera/core/duration_text.hpp"
 #include "chimera/svt/global_table.hpp"
 #include "float64_multi_array.h"
 #include "sample_stamp.hpp"
@@ -26,6 +26,7 @@ namespace chimera {
 namespace {
 
 using dds_detail::SampleStamp;
+using dds_detail::WriterShape;
 using Msg = std_msgs_msg_dds__Float64MultiArray_;
 using Dim = std_msgs_msg_dds__MultiArrayDimension_;
 
@@ -73,8 +74,10 @@ struct ImportPort {
   ImportSpec spec;
   VarIndex index = 0;
   dds_entity_t reader = 0;
-  std::int64_t last_update_ns = 0;  // monotonic, ours; the bridge's start before the first sample
-  ImportStatus status;              // guarded by Impl::status_mutex
+  std::int64_t last_update_ns = 0;             // monotonic, ours; the bridge's start before the first sample
+  std::set<dds_instance_handle_t> discovered;  // remote writers whose shape was checked (the taker's)
+  bool said_stale = false;                     // the taker's: the last change reported was "stale"
+  ImportStatus status;                         // guarded by Impl::status_mutex
 };
 
 // The writer's stamp, in whichever dimension's label carries it; none from a ROS 2 node.
@@ -107,9 +110,10 @@ struct RemotePorts::Impl {
   std::thread publisher;
   std::thread taker;
 
-  mutable std::mutex status_mutex;  // imports[i].status, errors, reported
+  mutable std::mutex status_mutex;  // imports[i].status, errors, changes, reported
   std::vector<std::string> errors;
-  std::set<std::string> reported;  // "variable|writer" of wrong-size writers already named
+  std::vector<std::string> changes;                       // an import's first sample, stale, fresh again
+  std::set<std::string> reported;                         // "variable|writer|count" of wrong-size writers already named
   std::optional<IllegalConfigurationHold> stale_hold;     // the taker's thread only
   std::optional<IllegalConfigurationHold> conflict_hold;  // the taker's thread only
 
@@ -119,7 +123,11 @@ struct RemotePorts::Impl {
   void publish(ExportPort& port);
   void take_loop();
   void take(ImportPort& port);
+  void take_sample(ImportPort& port, const Msg& msg, const dds_sample_info_t& info);
+  Result<void> add_import(const ImportSpec& import, dds_entity_t subscriber, dds_entity_t topic, std::int64_t start);
   void check_echo(ExportPort& port);
+  void check_discovered(ImportPort& port);
+  void refuse_shape(const ImportPort& port, const std::string& who, std::uint32_t length);
   void judge_staleness();
   void report(const std::string& key, std::string message);
 };
@@ -131,11 +139,13 @@ void RemotePorts::Impl::publish(ExportPort& port) {
   const std::int64_t now = wall_ns();
   const std::string stamp = dds_detail::stamp_label(SampleStamp{spec.name, ++port.sequence, now});
   // dim[0] is the ROS idiom for a vector of count values; dim[1] of size 1 carries the stamp.
-  Dim dims[2] = {{const_cast<char*>(port.variable.c_str()), port.count, port.count},
-                 {const_cast<char*>(stamp.c_str()), 1, 1}};
+  // The generated C struct's labels are char*; dds_write only reads them.
+  std::array<Dim, 2> dims{Dim{const_cast<char*>(port.variable.c_str()), port.count,  // NOLINT(*-const-cast)
+                              port.count},
+                          Dim{const_cast<char*>(stamp.c_str()), 1, 1}};  // NOLINT(*-const-cast)
   Msg msg{};
   msg.layout.dim._length = msg.layout.dim._maximum = 2;
-  msg.layout.dim._buffer = dims;
+  msg.layout.dim._buffer = dims.data();
   msg.layout.data_offset = 0;
   msg.data._length = msg.data._maximum = port.count;
   msg.data._buffer = port.values.data();
@@ -155,40 +165,67 @@ void RemotePorts::Impl::publish_loop() {
 }
 
 void RemotePorts::Impl::take(ImportPort& port) {
-  void* samples[1] = {nullptr};
-  dds_sample_info_t info[1];
+  std::array<void*, 1> samples{nullptr};
+  std::array<dds_sample_info_t, 1> info{};
   while (true) {
-    const dds_return_t n = dds_take(port.reader, samples, info, 1, 1);
+    const dds_return_t n = dds_take(port.reader, samples.data(), info.data(), 1, 1);
     if (n <= 0) return;
-    if (info[0].valid_data) {
-      const auto* msg = static_cast<const Msg*>(samples[0]);
-      const std::optional<SampleStamp> stamp = stamp_of(*msg);
-      const std::uint32_t offset = msg->layout.data_offset;
-      const std::uint32_t length = msg->data._length >= offset ? msg->data._length - offset : 0;
-      const std::string writer = stamp ? stamp->writer : std::string();
-      if (length != port.spec.count) {
-        const std::string who = stamp ? fmt::format("subsystem {}", writer)
-                                      : fmt::format("a writer without a Chimera stamp (a ROS 2 node?, instance {:x})",
-                                                    info[0].publication_handle);
-        std::lock_guard guard(status_mutex);
-        ++port.status.refused;
-        const std::string key = fmt::format("{}|{}|{}", port.spec.variable, who, length);
-        if (reported.insert(key).second)
-          errors.push_back(fmt::format("import {}: subsystem {} reads f64[{}] but {} publishes f64[{}] on rt/{}; its "
-                                       "samples are refused",
-                                       port.spec.variable, spec.name, port.spec.count, who, length,
-                                       port.spec.variable));
-      } else {
-        table.write(port.index, msg->data._buffer + offset);
-        port.last_update_ns = monotonic_ns();
-        std::lock_guard guard(status_mutex);
-        ++port.status.samples;
-        port.status.writer = writer;
-        port.status.writer_sequence = stamp ? stamp->sequence : 0;
-        port.status.writer_time_ns = stamp ? stamp->time_ns : info[0].source_timestamp;
-      }
+    if (info[0].valid_data) take_sample(port, *static_cast<const Msg*>(samples[0]), info[0]);
+    dds_return_loan(port.reader, samples.data(), n);
+  }
+}
+
+void RemotePorts::Impl::take_sample(ImportPort& port, const Msg& msg, const dds_sample_info_t& info) {
+  const std::optional<SampleStamp> stamp = stamp_of(msg);
+  const std::uint32_t offset = msg.layout.data_offset;
+  const std::uint32_t length = msg.data._length >= offset ? msg.data._length - offset : 0;
+  const std::string writer = stamp ? stamp->writer : std::string();
+  const std::string who =
+      stamp ? fmt::format("subsystem {}", writer) : std::string("a writer without a Chimera stamp (a ROS 2 node?)");
+  if (length != port.spec.count) {
+    refuse_shape(port, stamp ? who : fmt::format("{}, instance {:x}", who, info.publication_handle), length);
+    std::lock_guard guard(status_mutex);
+    ++port.status.refused;
+    return;
+  }
+  table.write(port.index, msg.data._buffer + offset);
+  port.last_update_ns = monotonic_ns();
+  std::lock_guard guard(status_mutex);
+  if (++port.status.samples == 1)
+    changes.push_back(fmt::format("import {}: first sample, from {}", port.spec.variable, who));
+  port.status.writer = writer;
+  port.status.writer_sequence = stamp ? stamp->sequence : 0;
+  port.status.writer_time_ns = stamp ? stamp->time_ns : info.source_timestamp;
+}
+
+void RemotePorts::Impl::refuse_shape(const ImportPort& port, const std::string& who, std::uint32_t length) {
+  report(fmt::format("{}|{}|{}", port.spec.variable, who, length),
+         fmt::format("import {}: subsystem {} reads f64[{}] but {} publishes f64[{}] on rt/{}; its samples are refused",
+                     port.spec.variable, spec.name, port.spec.count, who, length, port.spec.variable));
+}
+
+// The shape check at discovery: a Chimera writer says its count in its USER_DATA, which arrives
+// with the writer's discovery, so a mismatch is named before (and without) any sample. A writer
+// without it (a ROS 2 node) is checked sample by sample, as every writer also is.
+void RemotePorts::Impl::check_discovered(ImportPort& port) {
+  dds_subscription_matched_status_t matched{};
+  dds_get_subscription_matched_status(port.reader, &matched);  // resets the status that woke us
+  std::vector<dds_instance_handle_t> writers(std::max<std::uint32_t>(matched.current_count, 1) + 8);
+  const dds_return_t n = dds_get_matched_publications(port.reader, writers.data(), writers.size());
+  for (dds_return_t i = 0; i < std::min<dds_return_t>(n, static_cast<dds_return_t>(writers.size())); ++i) {
+    const dds_instance_handle_t handle = writers[static_cast<std::size_t>(i)];
+    if (!port.discovered.insert(handle).second) continue;
+    dds_builtintopic_endpoint_t* endpoint = dds_get_matched_publication_data(port.reader, handle);
+    if (endpoint == nullptr) continue;
+    void* data = nullptr;
+    std::size_t size = 0;
+    if (endpoint->qos != nullptr && dds_qget_userdata(endpoint->qos, &data, &size) && data != nullptr) {
+      const auto shape = dds_detail::parse_shape_userdata(std::string_view(static_cast<const char*>(data), size));
+      if (shape && shape->count != port.spec.count)
+        refuse_shape(port, fmt::format("subsystem {}", shape->writer), shape->count);
+      dds_free(data);
     }
-    dds_return_loan(port.reader, samples, n);
+    dds_builtintopic_free_endpoint(endpoint);
   }
 }
 
@@ -196,10 +233,10 @@ void RemotePorts::Impl::take(ImportPort& port) {
 // producer. Both subsystems see the other's samples, so both refuse: the flag stays raised for
 // the rest of the run, since which value an importer holds is then anyone's guess.
 void RemotePorts::Impl::check_echo(ExportPort& port) {
-  void* samples[1] = {nullptr};
-  dds_sample_info_t info[1];
+  std::array<void*, 1> samples{nullptr};
+  std::array<dds_sample_info_t, 1> info{};
   while (true) {
-    const dds_return_t n = dds_take(port.echo, samples, info, 1, 1);
+    const dds_return_t n = dds_take(port.echo, samples.data(), info.data(), 1, 1);
     if (n <= 0) return;
     if (info[0].valid_data) {
       const auto* msg = static_cast<const Msg*>(samples[0]);
@@ -212,7 +249,7 @@ void RemotePorts::Impl::check_echo(ExportPort& port) {
                          port.variable, spec.name, who, port.variable));
       if (!conflict_hold) conflict_hold.emplace(table);
     }
-    dds_return_loan(port.echo, samples, n);
+    dds_return_loan(port.echo, samples.data(), n);
   }
 }
 
@@ -224,6 +261,15 @@ void RemotePorts::Impl::judge_staleness() {
     for (auto& port : imports) {
       port.status.stale = now - port.last_update_ns > port.spec.max_age_ns;
       any_stale = any_stale || port.status.stale;
+      if (port.status.stale == port.said_stale) continue;
+      port.said_stale = port.status.stale;
+      changes.push_back(port.status.stale
+                            ? fmt::format("import {}: stale, no sample for {} (max_age){}", port.spec.variable,
+                                          format_duration(now - port.last_update_ns),
+                                          options.hold_when_stale ? ": the illegal-configuration flag is raised" : "")
+                            : fmt::format("import {}: fresh again, from {}", port.spec.variable,
+                                          port.status.writer.empty() ? std::string("a writer without a Chimera stamp")
+                                                                     : "subsystem " + port.status.writer));
     }
   }
   if (!options.hold_when_stale) return;
@@ -235,15 +281,17 @@ void RemotePorts::Impl::take_loop() {
   // Wake at least this often to judge staleness; a tenth of the tightest max_age bounds how late.
   std::int64_t tick = options.poll_ns * 10;
   for (const auto& port : imports) tick = std::min(tick, std::max<std::int64_t>(port.spec.max_age_ns / 10, 100'000));
-  std::vector<dds_attach_t> triggered(imports.size() + 1 + exports.size());
+  std::vector<dds_attach_t> triggered(imports.size() + 1 + exports.size() + imports.size());
+  const std::size_t first_discovery = imports.size() + 1 + exports.size();
   while (!stopping.load(std::memory_order_relaxed)) {  // relaxed: the flag carries no data
     const dds_return_t n =
         dds_waitset_wait(waitset, triggered.data(), triggered.size(), static_cast<dds_duration_t>(tick));
     for (dds_return_t i = 0; i < n; ++i) {
       const auto which = static_cast<std::size_t>(triggered[static_cast<std::size_t>(i)]);
       if (which < imports.size()) take(imports[which]);
-      if (which > imports.size() && which - imports.size() - 1 < exports.size())
-        check_echo(exports[which - imports.size() - 1]);
+      if (which > imports.size() && which < first_discovery) check_echo(exports[which - imports.size() - 1]);
+      if (which >= first_discovery && which - first_discovery < imports.size())
+        check_discovered(imports[which - first_discovery]);
     }
     judge_staleness();
   }
@@ -275,8 +323,8 @@ Result<void> check_shape(const GlobalTable& table, const std::string& variable, 
                          std::string_view role, VarIndex& index) {
   const auto found = table.find(variable);
   if (!found)
-    return make_error(Errc::kInvalidInput, fmt::format("{} {}: not a variable of table {}", role, variable,
-                                                       table.shm_name()));
+    return make_error(Errc::kInvalidInput,
+                      fmt::format("{} {}: not a variable of table {}", role, variable, table.shm_name()));
   const VarShape shape = table.shape(*found);
   if (shape.type != ElemType::kF64 || (count != 0 && shape.count != count))
     return make_error(Errc::kInvalidInput, fmt::format("{} {}: the table holds it as {}[{}], not f64[{}]", role,
@@ -286,6 +334,36 @@ Result<void> check_shape(const GlobalTable& table, const std::string& variable, 
 }
 
 }  // namespace
+
+// One import's reader on `topic`, attached to the taker's waitset for its data and its discovered
+// writers.
+Result<void> RemotePorts::Impl::add_import(const ImportSpec& import, dds_entity_t subscriber, dds_entity_t topic,
+                                           std::int64_t start) {
+  ImportPort port;
+  port.spec = import;
+  port.status.variable = import.variable;
+  port.last_update_ns = start;
+  if (auto ok = check_shape(table, import.variable, import.count, "import", port.index); !ok) return ok;
+  Qos qos;
+  dds_qset_history(qos.q, DDS_HISTORY_KEEP_LAST, 1);
+  dds_qset_reliability(
+      qos.q, import.reliability == DdsReliability::kReliable ? DDS_RELIABILITY_RELIABLE : DDS_RELIABILITY_BEST_EFFORT,
+      DDS_MSECS(100));
+  dds_qset_durability(qos.q, import.durability == DdsDurability::kTransientLocal ? DDS_DURABILITY_TRANSIENT_LOCAL
+                                                                                 : DDS_DURABILITY_VOLATILE);
+  port.reader = topic < 0 ? topic : dds_create_reader(subscriber, topic, qos.q, nullptr);
+  const dds_entity_t ready = port.reader < 0 ? port.reader : dds_create_readcondition(port.reader, DDS_ANY_STATE);
+  if (ready < 0 || dds_waitset_attach(waitset, ready, static_cast<dds_attach_t>(imports.size())) < 0)
+    return make_error(Errc::kInvalidInput, dds_error(fmt::format("import {}", import.variable), ready));
+  // The reader itself, woken only when a writer is matched or lost: its shape is checked then.
+  const dds_return_t mask = dds_set_status_mask(port.reader, DDS_SUBSCRIPTION_MATCHED_STATUS);
+  if (mask < 0 ||
+      dds_waitset_attach(waitset, port.reader,
+                         static_cast<dds_attach_t>(spec.imports.size() + 1 + spec.exports.size() + imports.size())) < 0)
+    return make_error(Errc::kInvalidInput, dds_error(fmt::format("import {}: discovery", import.variable), mask));
+  imports.push_back(std::move(port));
+  return {};
+}
 
 Result<std::unique_ptr<RemotePorts>> RemotePorts::create(const SubsystemSpec& spec, std::string_view table_name,
                                                          RemotePortsOptions options) {
@@ -305,16 +383,17 @@ Result<std::unique_ptr<RemotePorts>> RemotePorts::create(const SubsystemSpec& sp
   const dds_entity_t subscriber = dds_create_subscriber(m.participant.id, group.q, nullptr);
   if (publisher < 0 || subscriber < 0)
     return make_error(Errc::kInvalidInput, dds_error("publisher and subscriber", std::min(publisher, subscriber)));
-  // Attached to the waitset as: import i -> i, the wake-up -> imports.size(), export k's echo ->
-  // imports.size() + 1 + k.
+  // Attached to the waitset as: import i's data -> i, the wake-up -> imports.size(), export k's
+  // echo -> imports.size() + 1 + k, import i's discovered writers -> imports.size() + 1 +
+  // exports.size() + i.
   m.waitset = dds_create_waitset(m.participant.id);
   m.wake = dds_create_guardcondition(m.participant.id);
   if (m.waitset < 0 || m.wake < 0 ||
       dds_waitset_attach(m.waitset, m.wake, static_cast<dds_attach_t>(spec.imports.size())) < 0)
     return make_error(Errc::kInvalidInput, dds_error("waitset", std::min(m.waitset, m.wake)));
   auto topic = [&](const std::string& variable) {
-    return dds_create_topic(m.participant.id, &std_msgs_msg_dds__Float64MultiArray__desc,
-                            ("rt/" + variable).c_str(), nullptr, nullptr);
+    return dds_create_topic(m.participant.id, &std_msgs_msg_dds__Float64MultiArray__desc, ("rt/" + variable).c_str(),
+                            nullptr, nullptr);
   };
 
   for (const auto& x : spec.exports) {
@@ -329,6 +408,9 @@ Result<std::unique_ptr<RemotePorts>> RemotePorts::create(const SubsystemSpec& sp
     dds_qset_history(qos.q, DDS_HISTORY_KEEP_LAST, 1);
     dds_qset_reliability(qos.q, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
     dds_qset_durability(qos.q, DDS_DURABILITY_TRANSIENT_LOCAL);
+    // Its shape, for every importer to check at discovery (check_discovered).
+    const std::string shape = dds_detail::shape_userdata(WriterShape{spec.name, port.count});
+    dds_qset_userdata(qos.q, shape.data(), shape.size());
     port.writer = t < 0 ? t : dds_create_writer(publisher, t, qos.q, nullptr);
     // The echo hears every other writer of the topic in the partition, never this participant's.
     Qos echo_qos;
@@ -337,34 +419,14 @@ Result<std::unique_ptr<RemotePorts>> RemotePorts::create(const SubsystemSpec& sp
     dds_qset_ignorelocal(echo_qos.q, DDS_IGNORELOCAL_PARTICIPANT);
     port.echo = port.writer < 0 ? port.writer : dds_create_reader(subscriber, t, echo_qos.q, nullptr);
     const dds_entity_t heard = port.echo < 0 ? port.echo : dds_create_readcondition(port.echo, DDS_ANY_STATE);
-    if (heard < 0 || dds_waitset_attach(m.waitset, heard,
-                                        static_cast<dds_attach_t>(spec.imports.size() + 1 + m.exports.size())) < 0)
+    if (heard < 0 ||
+        dds_waitset_attach(m.waitset, heard, static_cast<dds_attach_t>(spec.imports.size() + 1 + m.exports.size())) < 0)
       return make_error(Errc::kInvalidInput, dds_error(fmt::format("export {}", x.variable), heard));
     m.exports.push_back(std::move(port));
   }
   const std::int64_t start = monotonic_ns();
-  for (const auto& i : spec.imports) {
-    ImportPort port;
-    port.spec = i;
-    port.status.variable = i.variable;
-    port.last_update_ns = start;
-    if (auto ok = check_shape(m.table, i.variable, i.count, "import", port.index); !ok) return ok.error();
-    const dds_entity_t t = topic(i.variable);
-    Qos qos;
-    dds_qset_history(qos.q, DDS_HISTORY_KEEP_LAST, 1);
-    dds_qset_reliability(qos.q,
-                         i.reliability == DdsReliability::kReliable ? DDS_RELIABILITY_RELIABLE
-                                                                     : DDS_RELIABILITY_BEST_EFFORT,
-                         DDS_MSECS(100));
-    dds_qset_durability(qos.q, i.durability == DdsDurability::kTransientLocal ? DDS_DURABILITY_TRANSIENT_LOCAL
-                                                                               : DDS_DURABILITY_VOLATILE);
-    port.reader = t < 0 ? t : dds_create_reader(subscriber, t, qos.q, nullptr);
-    const dds_entity_t ready = port.reader < 0 ? port.reader : dds_create_readcondition(port.reader, DDS_ANY_STATE);
-    if (ready < 0 ||
-        dds_waitset_attach(m.waitset, ready, static_cast<dds_attach_t>(m.imports.size())) < 0)
-      return make_error(Errc::kInvalidInput, dds_error(fmt::format("import {}", i.variable), ready));
-    m.imports.push_back(std::move(port));
-  }
+  for (const auto& i : spec.imports)
+    if (auto added = m.add_import(i, subscriber, topic(i.variable), start); !added) return added.error();
 
   if (!m.exports.empty()) m.publisher = std::thread([&m] { m.publish_loop(); });
   m.taker = std::thread([&m] { m.take_loop(); });  // also the exports' echoes
@@ -382,6 +444,11 @@ std::vector<ImportStatus> RemotePorts::imports() const {
 std::vector<std::string> RemotePorts::take_errors() {
   std::lock_guard guard(impl_->status_mutex);
   return std::exchange(impl_->errors, {});
+}
+
+std::vector<std::string> RemotePorts::take_changes() {
+  std::lock_guard guard(impl_->status_mutex);
+  return std::exchange(impl_->changes, {});
 }
 
 }  // namespace chimera

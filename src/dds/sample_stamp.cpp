@@ -34,4 +34,20 @@ std::optional<SampleStamp> parse_stamp_label(std::string_view label) {
   return stamp;
 }
 
+std::string shape_userdata(const WriterShape& shape) {
+  return fmt::format("{}{};type=f64;count={}", kPrefix, shape.writer, shape.count);
+}
+
+std::optional<WriterShape> parse_shape_userdata(std::string_view data) {
+  constexpr std::string_view kCount = ";type=f64;count=";
+  if (!data.starts_with(kPrefix)) return std::nullopt;
+  data.remove_prefix(kPrefix.size());
+  const auto count = data.rfind(kCount);
+  if (count == std::string_view::npos) return std::nullopt;
+  WriterShape shape;
+  shape.writer = std::string(data.substr(0, count));
+  if (!parse_int(data.substr(count + kCount.size()), shape.count)) return std::nullopt;
+  return shape;
+}
+
 }  // namespace chimera::dds_detail

@@ -23,4 +23,17 @@ std::string stamp_label(const SampleStamp& stamp);
 /// sample carries none). Not real-time safe.
 std::optional<SampleStamp> parse_stamp_label(std::string_view label);
 
+/// What an exporting writer says of itself in its USER_DATA QoS, which every reader learns at
+/// discovery, before any sample: its subsystem and the variable's element count.
+struct WriterShape {
+  std::string writer;
+  std::uint32_t count = 0;
+};
+
+/// "chimera:from=vision;type=f64;count=6". Not real-time safe.
+std::string shape_userdata(const WriterShape& shape);
+/// The shape of user data made by shape_userdata(); nullopt for anything else (a ROS 2 node's
+/// writer has none). Not real-time safe.
+std::optional<WriterShape> parse_shape_userdata(std::string_view data);
+
 }  // namespace chimera::dds_detail

@@ -51,8 +51,13 @@ class RemotePorts {
   /// Each import, in file order. Any thread; not real-time safe.
   [[nodiscard]] std::vector<ImportStatus> imports() const;
   /// Problems seen since the last call, one line each, oldest first: a remote writer of the wrong
-  /// size (named, with both ends' shapes, once per writer and variable). Not real-time safe.
+  /// size (named, with both ends' shapes, once per writer and variable: at its discovery when it
+  /// is a Chimera subsystem, else at its first sample), a second exporter of a variable (eq. 1).
+  /// Not real-time safe.
   [[nodiscard]] std::vector<std::string> take_errors();
+  /// What changed since the last call, one line each, oldest first: an import's first sample, an
+  /// import gone stale (past max_age), fresh again. Not real-time safe.
+  [[nodiscard]] std::vector<std::string> take_changes();
 
   struct Impl;
 

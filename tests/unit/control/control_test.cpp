@@ -201,6 +201,9 @@ TEST_F(ControlTest, FaultGoesToErrorAndClearBringsItBack) {
   EXPECT_EQ(control_->drain_events(), "");  // drained
   EXPECT_EQ(status_row("faulty").at(2), "ERROR");
   EXPECT_EQ(state_of("counter"), TaskState::kOn);  // the others run on
+  // A task in ERROR holds the illegal-configuration flag, and status says so.
+  const std::string flag_line = "illegal-configuration flag raised: the robot interfaces hold the arm\n";
+  EXPECT_TRUE(run("status").text.ends_with(flag_line)) << run("status").text;
 
   // clear while the fault persists: refused by the module, still ERROR
   Reply r = run("clear faulty");
@@ -211,6 +214,7 @@ TEST_F(ControlTest, FaultGoesToErrorAndClearBringsItBack) {
   r = run("clear faulty");
   EXPECT_TRUE(r.ok) << r.text;
   EXPECT_EQ(r.text, "faulty: OFF\n");
+  EXPECT_EQ(run("status").text.find("illegal-configuration flag"), std::string::npos) << run("status").text;
   EXPECT_EQ(run("on faulty").text, "faulty: ON\n");
   subsystem_->run_for(2 * kMs);
   EXPECT_EQ(run("get health").text, "health = [1]\n");

@@ -7,15 +7,19 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <functional>
 #include <string>
 #include <thread>
+#include <vector>
 
+#include <dds/dds.h>
 #include <gtest/gtest.h>
 
 #include "chimera/svt/global_table.hpp"
+#include "float64_multi_array.h"
 
 namespace chimera {
 namespace {
@@ -138,15 +142,144 @@ TEST(RemotePorts, AnImportGoesStaleAndHoldsTheFlagWhenThePublisherStops) {
   EXPECT_FALSE(robot.table.illegal_configuration());
 }
 
-TEST(RemotePorts, ARemoteOfTheWrongSizeIsRefusedAndNamed) {
+// A writer as a ROS 2 node makes one: a plain Float64MultiArray on rt/x_d, no Chimera stamp and
+// no shape in its user data, reliable and keep last 1 (so a flood replaces, never blocks).
+struct RawWriter {
+  dds_entity_t participant = dds_create_participant(DDS_DOMAIN_DEFAULT, nullptr, nullptr);
+  dds_entity_t writer = 0;
+
+  explicit RawWriter(const std::string& partition) {
+    dds_qos_t* qos = dds_create_qos();
+    dds_qset_partition1(qos, partition.c_str());
+    const dds_entity_t publisher = dds_create_publisher(participant, qos, nullptr);
+    dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+    dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 1);
+    dds_qset_durability(qos, DDS_DURABILITY_TRANSIENT_LOCAL);  // what importer() asks for
+    const dds_entity_t topic =
+        dds_create_topic(participant, &std_msgs_msg_dds__Float64MultiArray__desc, "rt/x_d", nullptr, nullptr);
+    writer = dds_create_writer(publisher, topic, qos, nullptr);
+    dds_delete_qos(qos);
+    EXPECT_GT(writer, 0);
+  }
+  ~RawWriter() { dds_delete(participant); }
+  RawWriter(const RawWriter&) = delete;
+  RawWriter& operator=(const RawWriter&) = delete;
+
+  void write(std::vector<double> values, std::uint32_t data_offset = 0) const {
+    std::string label = "x_d";
+    std_msgs_msg_dds__MultiArrayDimension_ dim{label.data(), static_cast<std::uint32_t>(values.size()),
+                                               static_cast<std::uint32_t>(values.size())};
+    std_msgs_msg_dds__Float64MultiArray_ msg{};
+    msg.layout.dim._length = msg.layout.dim._maximum = 1;
+    msg.layout.dim._buffer = &dim;
+    msg.layout.data_offset = data_offset;
+    msg.data._length = msg.data._maximum = static_cast<std::uint32_t>(values.size());
+    msg.data._buffer = values.data();
+    EXPECT_EQ(dds_write(writer, &msg), DDS_RETCODE_OK);
+  }
+};
+
+std::vector<std::string> collect_errors(RemotePorts& ports, std::vector<std::string>& errors) {
+  auto more = ports.take_errors();
+  errors.insert(errors.end(), more.begin(), more.end());
+  return errors;
+}
+
+// A writer that says nothing of its shape (a ROS 2 node) is checked sample by sample.
+TEST(RemotePorts, AWriterWithoutAStampOfTheWrongSizeIsRefusedSampleBySample) {
+  Side robot = importer(6);
+  auto in = bridge(robot);
+  ASSERT_TRUE(in);
+  const RawWriter ros_node(robot.spec.dds.partition);
+  ASSERT_TRUE(eventually([&] {
+    ros_node.write({1, 2, 3, 4, 5, 6, 7});
+    return in->imports().front().refused >= 1;
+  }));
+  std::vector<std::string> errors;
+  collect_errors(*in, errors);
+  ASSERT_EQ(errors.size(), 1U);
+  const std::string head = "import x_d: subsystem " + robot.spec.name +
+                           " reads f64[6] but a writer without a Chimera stamp (a ROS 2 node?), instance ";
+  EXPECT_TRUE(errors[0].starts_with(head)) << errors[0];
+  EXPECT_TRUE(errors[0].ends_with(" publishes f64[7] on rt/x_d; its samples are refused")) << errors[0];
+  EXPECT_EQ(in->imports().front().samples, 0U);
+  EXPECT_EQ(robot.table.version(robot.index), 0U);  // never written: no garbage
+  // More wrong samples are counted, not reported again.
+  const std::uint64_t before = in->imports().front().refused;
+  ASSERT_TRUE(eventually([&] {
+    ros_node.write({1, 2, 3, 4, 5, 6, 7});
+    return in->imports().front().refused > before;
+  }));
+  EXPECT_TRUE(in->take_errors().empty());
+  EXPECT_EQ(robot.table.version(robot.index), 0U);
+}
+
+// A ROS 2 node can publish into an import; data_offset is honoured, and an offset past the data
+// (a malformed layout, though valid CDR) is refused as having no values.
+TEST(RemotePorts, ARos2NodeCanPublishIntoAnImportAndAMalformedLayoutIsRefused) {
+  Side robot = importer(6);
+  auto in = bridge(robot);
+  ASSERT_TRUE(in);
+  const RawWriter ros_node(robot.spec.dds.partition);
+  ASSERT_TRUE(eventually([&] {
+    ros_node.write({1, 2, 3, 4, 5, 6}, 10);
+    return in->imports().front().refused >= 1;
+  }));
+  std::vector<std::string> errors;
+  collect_errors(*in, errors);
+  ASSERT_EQ(errors.size(), 1U);
+  EXPECT_TRUE(errors[0].ends_with(" publishes f64[0] on rt/x_d; its samples are refused")) << errors[0];
+  EXPECT_EQ(robot.table.version(robot.index), 0U);
+
+  ASSERT_TRUE(eventually([&] {
+    ros_node.write({-1, -2, 1, 2, 3, 4, 5, 6}, 2);
+    return in->imports().front().samples >= 1;
+  }));
+  std::array<double, 6> got{};
+  robot.table.read(robot.index, got.data(), 0);
+  EXPECT_EQ(got, (std::array<double, 6>{1, 2, 3, 4, 5, 6}));
+  const ImportStatus status = in->imports().front();
+  EXPECT_EQ(status.writer, "");  // no Chimera stamp
+  EXPECT_EQ(status.writer_sequence, 0U);
+  EXPECT_GT(status.writer_time_ns, 0);  // DDS's source timestamp instead
+  const auto changes = in->take_changes();
+  EXPECT_NE(std::find(changes.begin(), changes.end(),
+                      "import x_d: first sample, from a writer without a Chimera stamp (a ROS 2 node?)"),
+            changes.end());
+}
+
+// A flood of samples is taken as the latest value: never queued, and the bridge keeps up with
+// whatever comes last.
+TEST(RemotePorts, AFloodOfSamplesEndsAtTheLatestValue) {
+  Side robot = importer(6);
+  auto in = bridge(robot);
+  ASSERT_TRUE(in);
+  const RawWriter ros_node(robot.spec.dds.partition);
+  ASSERT_TRUE(eventually([&] {
+    ros_node.write({0, 0, 0, 0, 0, 0});
+    return in->imports().front().samples >= 1;
+  }));
+  constexpr int kFlood = 20'000;
+  for (int i = 1; i <= kFlood; ++i) ros_node.write(std::vector<double>(6, static_cast<double>(i)));
+  std::array<double, 6> got{};
+  ASSERT_TRUE(eventually([&] {
+    robot.table.read(robot.index, got.data(), 0);
+    return got[0] == kFlood;
+  })) << "the import holds "
+      << got[0];
+  EXPECT_EQ(got, (std::array<double, 6>{kFlood, kFlood, kFlood, kFlood, kFlood, kFlood}));
+  EXPECT_LE(in->imports().front().samples, static_cast<std::uint64_t>(kFlood) + 1);
+  EXPECT_TRUE(in->take_errors().empty());
+  EXPECT_FALSE(in->imports().front().stale);
+}
+
+// A Chimera writer says its shape when it is discovered: the mismatch is named before any sample.
+TEST(RemotePorts, ARemoteOfTheWrongSizeIsNamedAtDiscoveryBeforeAnySample) {
   Side vision = exporter(7);
   Side robot = importer(6);
   auto out = bridge(vision);
   auto in = bridge(robot);
   ASSERT_TRUE(out && in);
-  const std::array<double, 7> wrong{1, 2, 3, 4, 5, 6, 7};
-  vision.table.write(vision.index, wrong.data());
-
   std::vector<std::string> errors;
   ASSERT_TRUE(eventually([&] {
     auto more = in->take_errors();
@@ -154,16 +287,57 @@ TEST(RemotePorts, ARemoteOfTheWrongSizeIsRefusedAndNamed) {
     return !errors.empty();
   }));
   ASSERT_EQ(errors.size(), 1U);
-  EXPECT_EQ(errors[0], "import x_d: subsystem " + robot.spec.name + " reads f64[6] but subsystem " +
-                           vision.spec.name + " publishes f64[7] on rt/x_d; its samples are refused");
-  const ImportStatus status = in->imports().front();
-  EXPECT_GE(status.refused, 1U);
-  EXPECT_EQ(status.samples, 0U);
-  EXPECT_EQ(robot.table.version(robot.index), 0U);  // never written: no garbage
-  // More wrong samples are counted, not reported again.
+  EXPECT_EQ(errors[0], "import x_d: subsystem " + robot.spec.name + " reads f64[6] but subsystem " + vision.spec.name +
+                           " publishes f64[7] on rt/x_d; its samples are refused");
+  EXPECT_EQ(vision.table.version(vision.index), 0U);  // nothing was ever written, nor sent
+  EXPECT_EQ(in->imports().front().refused, 0U);
+  // Its first sample is refused too, and not named a second time.
+  const std::array<double, 7> wrong{1, 2, 3, 4, 5, 6, 7};
   vision.table.write(vision.index, wrong.data());
-  ASSERT_TRUE(eventually([&] { return in->imports().front().refused >= 2; }));
+  ASSERT_TRUE(eventually([&] { return in->imports().front().refused >= 1; }));
   EXPECT_TRUE(in->take_errors().empty());
+  EXPECT_EQ(robot.table.version(robot.index), 0U);
+}
+
+// What an operator is told as it happens: the first sample, stale, fresh again.
+TEST(RemotePorts, AnImportsChangesAreToldOnceEach) {
+  Side vision = exporter(6);
+  Side robot = importer(6);
+  auto in = bridge(robot);
+  ASSERT_TRUE(in);
+  std::vector<std::string> changes;
+  auto collect = [&] {
+    for (auto& c : in->take_changes()) changes.push_back(c);
+  };
+  ASSERT_TRUE(eventually([&] {
+    collect();
+    return !changes.empty();
+  }));
+  // The taker judges every 5 ms (max_age / 10): twenty judgements later, still the one change.
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  collect();
+  ASSERT_EQ(changes.size(), 1U);
+  EXPECT_TRUE(changes[0].starts_with("import x_d: stale, no sample for ")) << changes[0];
+  EXPECT_TRUE(changes[0].ends_with(" (max_age): the illegal-configuration flag is raised")) << changes[0];
+
+  auto out = bridge(vision);
+  const std::array<double, 6> pose{1, 1, 1, 1, 1, 1};
+  ASSERT_TRUE(eventually([&] {
+    vision.table.write(vision.index, pose.data());
+    collect();
+    return changes.size() >= 3;
+  }));
+  EXPECT_EQ(changes[1], "import x_d: first sample, from subsystem " + vision.spec.name);
+  EXPECT_EQ(changes[2], "import x_d: fresh again, from subsystem " + vision.spec.name);
+  // Whatever a loaded machine's stalls do to a 50 ms max_age, stale and fresh alternate.
+  for (int i = 0; i < 20; ++i) {
+    vision.table.write(vision.index, pose.data());
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  collect();
+  for (std::size_t i = 3; i < changes.size(); ++i)
+    EXPECT_EQ(changes[i].starts_with("import x_d: stale"), changes[i - 1].starts_with("import x_d: fresh"))
+        << changes[i];
 }
 
 TEST(RemotePorts, TwoSubsystemsExportingOneVariableAreRefusedByBoth) {

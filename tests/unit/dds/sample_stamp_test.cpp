@@ -27,5 +27,23 @@ TEST(SampleStamp, OtherLabelsAreNoStamp) {
   EXPECT_FALSE(parse_stamp_label("chimera:from=a;seq=1;t=").has_value());
 }
 
+TEST(WriterShape, RoundTrip) {
+  const std::string data = shape_userdata(WriterShape{"vision_side", 6});
+  EXPECT_EQ(data, "chimera:from=vision_side;type=f64;count=6");
+  const auto back = parse_shape_userdata(data);
+  ASSERT_TRUE(back.has_value());
+  EXPECT_EQ(back->writer, "vision_side");
+  EXPECT_EQ(back->count, 6U);
+}
+
+TEST(WriterShape, OtherUserDataIsNoShape) {
+  EXPECT_FALSE(parse_shape_userdata("").has_value());  // a ROS 2 node's writer
+  EXPECT_FALSE(parse_shape_userdata("enclave=/;").has_value());
+  EXPECT_FALSE(parse_shape_userdata("chimera:from=a;type=f64;count=").has_value());
+  EXPECT_FALSE(parse_shape_userdata("chimera:from=a;type=f64;count=6x").has_value());
+  EXPECT_FALSE(parse_shape_userdata("chimera:from=a;count=6").has_value());
+  EXPECT_FALSE(parse_shape_userdata("chimera:from=a;type=f64;count=99999999999").has_value());
+}
+
 }  // namespace
 }  // namespace chimera::dds_detail
