@@ -73,7 +73,8 @@ start: main
 exports: [x_d]
 imports:
   x_m: { type: f64, count: 6, max_age: 500ms }
-dds: { partition: )" + n.partition + " }\n";
+dds: { partition: )" +
+         n.partition + " }\n";
 }
 
 std::string robot_file(const Names& n) {
@@ -92,7 +93,8 @@ start: main
 exports: [x_m]
 imports:
   x_d: { type: f64, count: 6, max_age: 500ms }
-dds: { partition: )" + n.partition + " }\n";
+dds: { partition: )" +
+         n.partition + " }\n";
 }
 
 // One `chimera run` of a file, on the network stack its launcher puts it on.
@@ -110,7 +112,7 @@ struct Side {
   [[nodiscard]] std::string err() const { return process->err(); }
 
   // The reply to `command`: `get theta_m` goes behind it, and its reply ends the first one's.
-  std::string ask(const std::string& command) {
+  std::string ask(const std::string& command) const {
     const std::size_t before = process->out().size();
     process->send(command + "\nget theta_m\n");
     std::string reply;
@@ -121,12 +123,12 @@ struct Side {
     });
     return reply;
   }
-  std::string theta_m() { return ask("# theta_m"); }
-  bool flag_raised() { return ask("status").find(kFlag) != std::string::npos; }
+  std::string theta_m() const { return ask("# theta_m"); }
+  bool flag_raised() const { return ask("status").find(kFlag) != std::string::npos; }
 
   // The arm holds: two readings of theta_m half a second apart differ by under a milliradian
   // (held in position mode, the simulated servo settles where the flag found the arm).
-  bool holds() {
+  bool holds() const {
     const std::vector<double> first = values(theta_m());
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
     const std::vector<double> second = values(theta_m());
@@ -187,7 +189,10 @@ class NetworkPair {
   bool link(bool up) { return sh("ip -n " + vision_ns_ + " link set " + vision_link_ + (up ? " up" : " down")); }
 
  private:
-  static bool sh(const std::string& command) { return std::system(command.c_str()) == 0; }  // NOLINT(cert-env33-c)
+  // ip, on the test's own thread: nothing else calls system() or changes the environment meanwhile.
+  static bool sh(const std::string& command) {
+    return std::system(command.c_str()) == 0;  // NOLINT(cert-env33-c,concurrency-mt-unsafe)
+  }
 
   bool made_ = false;
   std::string vision_ns_;
@@ -251,8 +256,7 @@ void robot_holds_while_vision_is_away(const std::vector<std::string>& vision_lau
 
   // Brought back (its stale shared memory is no obstacle): fresh again, the flag down, the arm moving.
   vision = std::make_unique<Side>(names.vision, vision_file(names), vision_launcher);
-  ASSERT_TRUE(eventually([&] { return count(robot.err(), fresh) > fresh_before; })) << robot.err()
-                                                                                    << vision->err();
+  ASSERT_TRUE(eventually([&] { return count(robot.err(), fresh) > fresh_before; })) << robot.err() << vision->err();
   EXPECT_TRUE(eventually([&] { return !robot.flag_raised(); })) << robot.ask("status");
   const std::string moving = robot.theta_m();
   EXPECT_TRUE(eventually([&] { return robot.theta_m() != moving; }));

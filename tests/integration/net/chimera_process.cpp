@@ -25,11 +25,12 @@ bool reap(int pid, int& code, bool block) {
 }  // namespace
 
 ChimeraProcess::ChimeraProcess(const TempDir& dir, const std::vector<std::string>& args,
-                               const std::vector<std::string>& env)
+                               const std::vector<std::string>& env, const std::vector<std::string>& launcher)
     : out_path_(dir.file("process.out")), err_path_(dir.file("process.err")) {
   int pipe_fds[2];
   if (::pipe2(pipe_fds, O_CLOEXEC) != 0) throw std::runtime_error("pipe failed");
-  std::vector<std::string> words{CHIMERA_BIN};
+  std::vector<std::string> words = launcher;
+  words.emplace_back(CHIMERA_BIN);
   words.insert(words.end(), args.begin(), args.end());
   pid_ = ::fork();
   if (pid_ < 0) throw std::runtime_error("fork failed");
@@ -44,7 +45,7 @@ ChimeraProcess::ChimeraProcess(const TempDir& dir, const std::vector<std::string
     std::vector<char*> argv;
     for (auto& w : words) argv.push_back(w.data());
     argv.push_back(nullptr);
-    ::execv(argv[0], argv.data());
+    ::execvp(argv[0], argv.data());  // a launcher is looked up on PATH; chimera's path is absolute
     ::_exit(127);
   }
   ::close(pipe_fds[0]);

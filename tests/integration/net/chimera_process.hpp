@@ -11,8 +11,11 @@ namespace chimera::test {
 
 class ChimeraProcess {
  public:
-  /// Starts `chimera args...` in `dir`'s files; `env` entries ("NAME=value") are added.
-  ChimeraProcess(const TempDir& dir, const std::vector<std::string>& args, const std::vector<std::string>& env = {});
+  /// Starts `chimera args...` in `dir`'s files; `env` entries ("NAME=value") are added. A
+  /// `launcher` goes before the command and must exec it in its own place, so that pid() is
+  /// chimera's (e.g. {"ip", "netns", "exec", "NAME"}: the run on another network stack).
+  ChimeraProcess(const TempDir& dir, const std::vector<std::string>& args, const std::vector<std::string>& env = {},
+                 const std::vector<std::string>& launcher = {});
   /// Ends the process if it still runs (SIGTERM, then SIGKILL).
   ~ChimeraProcess();
   ChimeraProcess(const ChimeraProcess&) = delete;
