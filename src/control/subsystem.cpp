@@ -12,6 +12,7 @@
 #include <utility>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "chimera/svt/global_table.hpp"
 #include "chimera/svt/value_codec.hpp"
@@ -141,7 +142,18 @@ Result<void> Subsystem::Impl::build_runtime(const std::string& configuration, st
 }
 
 Subsystem::Subsystem() : impl_(std::make_unique<Impl>()) {}
-Subsystem::~Subsystem() { stop(); }
+Subsystem::~Subsystem() {
+  stop();
+  // A thread left behind by the stop may still run its module's code on these tasks, this
+  // executive and the table: they are kept, reachable, for the rest of the process.
+  if (!impl_->left_behind.empty()) {
+    // Never freed, on purpose, and never destroyed at exit (the thread may still run then); a bad
+    // allocation here ends the process, which is ending anyway.
+    // NOLINTNEXTLINE(cppcoreguidelines-owning-memory,cppcoreguidelines-avoid-non-const-global-variables,bugprone-unhandled-exception-at-new)
+    static auto* kept = new std::vector<std::unique_ptr<Impl>>();
+    kept->push_back(std::move(impl_));
+  }
+}
 
 Result<std::unique_ptr<Subsystem>> Subsystem::create(const SubsystemSpec& spec, const Registry& registry,
                                                      RunOptions options) {
@@ -248,6 +260,7 @@ void Subsystem::stop() {
   m.executive->stop_serving();
   std::lock_guard<std::mutex> lock(m.ops_mutex);
   if (m.stopped) return;
+  m.executive->begin_stop();  // a task stuck in a method delays the stop by a bound, not for ever
   // The paper's two-step termination, every task off, then every task killed, signal by signal
   // so that what a module's kill reports is kept; then the executive ends its threads.
   for (std::size_t i = 0; i < m.tasks->size(); ++i)
@@ -258,7 +271,18 @@ void Subsystem::stop() {
   m.stopped = true;
   m.events->collect(*m.tasks);  // what off and kill reported stays readable, as do the tasks' figures
   std::unique_lock<std::shared_mutex> runtime(m.runtime_mutex);
-  m.table.reset();  // unlinks the shared memory
+  m.left_behind = m.executive->left_behind();
+  if (m.left_behind.empty()) {
+    m.table.reset();  // unlinks the shared memory
+    return;
+  }
+  // A thread stuck in a method still runs and may touch the table: its mapping stays, only the
+  // name goes (and with it the names of any other region of this process, which is about to end).
+  // ~Subsystem keeps everything else that thread may touch.
+  m.earlier_faults.push_back(fmt::format(
+      "{} stuck in a method when the run stopped: {} thread was left behind, and the process ends without it",
+      fmt::join(m.left_behind, ", "), m.left_behind.size() == 1 ? "its" : "their"));
+  GlobalTable::remove_owned_names_now();
 }
 
 std::int64_t Subsystem::now_ns() const {

@@ -67,6 +67,7 @@ struct Subsystem::Impl {
   // What earlier runtimes (before an add rebuilt it) left that the run still reports.
   std::vector<Event> earlier_events;         // not drained yet
   std::vector<std::string> earlier_faults;   // faults() lines
+  std::vector<std::string> left_behind;      // tasks whose thread stop() left behind, stuck in a method
   bool earlier_hard_failure = false;
 
   void note_kill(std::size_t task, const Result<void>& killed) {

@@ -136,6 +136,13 @@ class Executive {
   /// Stops serving, turns every task off, then kills it, and ends every thread. Idempotent. The
   /// tasks keep their figures and events; no signal may follow.
   virtual void shutdown() = 0;
+  /// The run is ending, and must end within a bound (issue 15): from now on a task's thread that
+  /// does not answer a signal within a second is taken for stuck in a method, every later signal
+  /// to its tasks is refused at once, and shutdown() leaves it behind rather than wait for ever.
+  virtual void begin_stop() = 0;
+  /// The tasks whose thread shutdown() left behind, stuck in a method. Whatever that thread may
+  /// still touch (its modules, tasks, this executive, the table) must then outlive the process.
+  [[nodiscard]] virtual std::vector<std::string> left_behind() const = 0;
 };
 
 /// The shortest period among the periodic tasks that leave or join in `commit` (0: none): a

@@ -45,6 +45,8 @@ class ProcessExecutive final : public Executive {
   void stop_serving() override { local_->stop_serving(); }
   void variable_written(VarIndex v) override { local_->variable_written(v); }
   void shutdown() override;
+  void begin_stop() override { local_->begin_stop(); }  // a module process's stuck task: its process is killed
+  [[nodiscard]] std::vector<std::string> left_behind() const override { return local_->left_behind(); }
 
  private:
   /// The module process that runs task `task`, or nullptr for the main process.

@@ -17,6 +17,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include "chimera/core/duration_text.hpp"
 #include "chimera/core/invariant.hpp"
 #include "chimera/exec/clock.hpp"
 #include "futex.hpp"
@@ -35,7 +36,9 @@ constexpr std::size_t kStackBytes = std::size_t{8} << 20;  // sanitizers need la
 constexpr bool kSanitized = false;
 constexpr std::size_t kStackBytes = std::size_t{1} << 20;  // locked by mlockall: keep it modest
 #endif
-constexpr std::int64_t kReplyTimeoutNs = 10'000'000'000;
+// Once the run is ending (begin_stop): how long a signal waits, and how long shutdown() waits for
+// a thread that did not answer, before taking it for stuck. The bound on a stop is about twice this.
+constexpr std::int64_t kStopReplyTimeoutNs = 1'000'000'000;
 constexpr int kTopFixedPriority = 80;
 constexpr int kLowestFixedPriority = 2;
 constexpr int kBackgroundPriority = 1;
@@ -218,9 +221,23 @@ void RealExecutive::form_threads() {
 
 RealExecutive::~RealExecutive() { shutdown(); }
 
+void RealExecutive::begin_stop() {
+  std::lock_guard<std::mutex> lock(control_mutex_);
+  reply_timeout_ns_ = std::min(reply_timeout_ns_, kStopReplyTimeoutNs);
+}
+
+std::vector<std::string> RealExecutive::left_behind() const {
+  std::vector<std::string> names;
+  for (const auto& t : threads_)
+    if (t->left_behind)
+      for (const Worker* w : t->members) names.push_back(w->task->name());
+  return names;
+}
+
 void RealExecutive::shutdown() {
   stop_serving();
   if (stopped_at_ns_ >= 0) return;
+  begin_stop();  // however the run ends, it ends within a bound
   // The paper's two-step termination: every task off, then every task killed.
   for (std::size_t i = 0; i < workers_.size(); ++i)
     if (hosts(i) && tasks_[i]->state() == TaskState::kOn) (void)signal(i, Signal::kOff);
@@ -228,12 +245,32 @@ void RealExecutive::shutdown() {
     Worker& w = *workers_[i];
     if (hosts(i) && w.thread->running && w.task->state() != TaskState::kNotCreated) (void)signal(i, Signal::kKill);
   }
-  for (auto& t : threads_)
-    if (t->running) pthread_join(t->handle, nullptr);  // its last member's kill ended it
+  bool any_left = false;
+  for (auto& t : threads_) {
+    if (!t->running) continue;
+    if (!t->unanswered) {
+      pthread_join(t->handle, nullptr);  // its last member's kill ended it
+      continue;
+    }
+    // Stuck in a method: it gets as long again to come back, then it is left behind. The
+    // process ends without it; what it may still touch is kept (left_behind()).
+    timespec until{};
+    clock_gettime(CLOCK_REALTIME, &until);  // pthread_timedjoin_np's clock
+    until.tv_sec += kStopReplyTimeoutNs / 1'000'000'000;
+    if (pthread_timedjoin_np(t->handle, nullptr, &until) == 0) {
+      t->running = false;
+      continue;
+    }
+    t->left_behind = true;
+    any_left = true;
+  }
   // The dispatchers read the workers' published jobs: they stop here, with no task thread left
   // to ring them, before the workers can be destroyed (TSAN saw a dispatcher read a freed worker).
-  for (auto& w : workers_) w->dispatcher = nullptr;
-  dispatchers_.clear();
+  // A thread left behind may still ring its dispatcher: then they stay.
+  if (!any_left) {
+    for (auto& w : workers_) w->dispatcher = nullptr;
+    dispatchers_.clear();
+  }
   stopped_at_ns_ = monotonic_ns() - epoch_ns_;
   // A hard job still overdue when the run stopped no longer holds the flag.
   for (std::size_t i = 0; i < overdue_hold_.size(); ++i)
@@ -317,14 +354,16 @@ std::uint32_t RealExecutive::send(Worker& w, const Mail& mail) {
   return seq;
 }
 
-Result<void> RealExecutive::await(Worker& w, std::uint32_t seq) {
-  const std::int64_t give_up = monotonic_ns() + kReplyTimeoutNs;
+Result<void> RealExecutive::await(Worker& w, std::uint32_t seq) const {
+  const std::int64_t give_up = monotonic_ns() + reply_timeout_ns_;
   for (;;) {
     const std::uint32_t done = w.mailbox.done_seq.load(std::memory_order_acquire);  // acquire: see `reply`
     if (done == seq) break;
-    if (!detail::futex_wait(w.mailbox.done_seq, done, give_up) && monotonic_ns() >= give_up)
-      return make_error(Errc::kModuleFault,
-                        fmt::format("{}: no answer within 10 s (a method is stuck?)", w.task->name()));
+    if (!detail::futex_wait(w.mailbox.done_seq, done, give_up) && monotonic_ns() >= give_up) {
+      w.thread->unanswered = true;
+      return make_error(Errc::kModuleFault, fmt::format("{}: no answer within {} (a method is stuck?)", w.task->name(),
+                                                        format_duration(reply_timeout_ns_)));
+    }
   }
   Result<void> r = std::move(w.mailbox.reply);
   w.mailbox.reply = Result<void>{};
@@ -335,15 +374,42 @@ Result<void> RealExecutive::await(Worker& w, std::uint32_t seq) {
   return r;
 }
 
-Result<void> RealExecutive::post(Worker& w, Mail mail) { return await(w, send(w, mail)); }
+Result<void> RealExecutive::answering(Worker& w) {
+  TaskThread& t = *w.thread;
+  if (!t.unanswered) return {};
+  // Caught up: every member's last mail answered (acquire: what it did before answering is seen).
+  const bool caught_up = std::all_of(t.members.begin(), t.members.end(), [](const Worker* m) {
+    return m->mailbox.done_seq.load(std::memory_order_acquire) ==
+           m->mailbox.request_seq.load(std::memory_order_relaxed);  // relaxed: only this thread writes it
+  });
+  if (caught_up) {
+    t.unanswered = false;
+    return {};
+  }
+  return make_error(Errc::kModuleFault,
+                    fmt::format("{}: its thread has not answered since an earlier signal (a method is stuck?)",
+                                w.task->name()));
+}
+
+Result<void> RealExecutive::post(Worker& w, Mail mail) {
+  if (auto ok = answering(w); !ok) return ok;
+  return await(w, send(w, mail));
+}
 
 Result<void> RealExecutive::post_all(const std::vector<std::size_t>& indices, const std::vector<Mail>& mails) {
   std::vector<std::uint32_t> seqs;
   seqs.reserve(indices.size());
-  for (std::size_t n = 0; n < indices.size(); ++n) seqs.push_back(send(*workers_[indices[n]], mails[n]));
+  std::vector<bool> sent;
   Result<void> first;
+  for (std::size_t n = 0; n < indices.size(); ++n) {
+    auto ok = answering(*workers_[indices[n]]);
+    if (!ok && first) first = ok;
+    sent.push_back(ok.ok());
+    seqs.push_back(ok ? send(*workers_[indices[n]], mails[n]) : 0);
+  }
   for (std::size_t n = 0; n < indices.size(); ++n)
-    if (auto r = await(*workers_[indices[n]], seqs[n]); !r && first) first = r;
+    if (sent[n])
+      if (auto r = await(*workers_[indices[n]], seqs[n]); !r && first) first = r;
   return first;
 }
 

@@ -51,6 +51,8 @@ class RealExecutive final : public Executive {
   void stop_serving() override;
   void variable_written(VarIndex v) override;
   void shutdown() override;
+  void begin_stop() override;
+  [[nodiscard]] std::vector<std::string> left_behind() const override;
 
   /// CLOCK_MONOTONIC at the executive's time 0. Real-time safe.
   [[nodiscard]] std::int64_t epoch_ns() const noexcept { return epoch_ns_; }
@@ -73,14 +75,17 @@ class RealExecutive final : public Executive {
   void form_threads();
   Result<void> start_thread(TaskThread& thread) const;
   /// Posts `mail` to a task's thread and waits for its answer.
-  static Result<void> post(Worker& w, Mail mail);
+  Result<void> post(Worker& w, Mail mail);
   /// Posts `mail` to several tasks' threads at once, then waits for every answer.
   Result<void> post_all(const std::vector<std::size_t>& indices, const std::vector<Mail>& mails);
   /// Tells the successors of the joining tasks the release each joins at: its first from `from_ns`.
   void publish_joins(const std::vector<std::size_t>& joining, std::int64_t from_ns);
   /// Posts only; returns the sequence number of the answer to wait for.
   static std::uint32_t send(Worker& w, const Mail& mail);
-  static Result<void> await(Worker& w, std::uint32_t seq);
+  Result<void> await(Worker& w, std::uint32_t seq) const;
+  /// Refuses at once a mail to a task whose thread left an earlier one unanswered and has not
+  /// caught up since (a method is stuck): a second wait would only add to the first.
+  static Result<void> answering(Worker& w);
   /// New urgency data (MUF's critical set after a switch) for the edf / muf dispatchers.
   void set_plan(SchedulePlan plan);
   /// The service thread's body, and one look at every task's running job (service_thread.cpp).
@@ -101,6 +106,7 @@ class RealExecutive final : public Executive {
   std::int64_t epoch_ns_ = 0;
   bool realtime_ = false;
   std::mutex control_mutex_;  // one control request at a time; never taken by a task's thread
+  std::int64_t reply_timeout_ns_ = 10'000'000'000;  // the control thread's: how long a signal waits for its answer
 
   // The service thread (service_thread.cpp) and what its overrun watch holds.
   std::thread service_;

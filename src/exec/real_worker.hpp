@@ -40,6 +40,8 @@ struct TaskThread {
   alignas(64) std::atomic<std::uint32_t> bell{0};
   int alive = 0;                     // members spawned and not killed; the thread's own count
   std::atomic<bool> exiting{false};  // set before the answer to the mail that killed its last member
+  bool unanswered = false;           // the control thread's: a mail went unanswered (a method is stuck)
+  bool left_behind = false;          // the control thread's: shutdown() gave up joining it
 
   /// The body: until no member is alive.
   void main();

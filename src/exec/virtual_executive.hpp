@@ -47,6 +47,10 @@ class VirtualExecutive final : public Executive {
   /// The simulation sees a new version of a trigger variable by itself.
   void variable_written(VarIndex /*v*/) override {}
   void shutdown() override;
+  // Its tasks run on the caller's thread: a method stuck there holds the caller, and nothing is
+  // left behind that could be waited for.
+  void begin_stop() override {}
+  [[nodiscard]] std::vector<std::string> left_behind() const override { return {}; }
 
   /// Runs every event before `end_ns`, then sets the time to `end_ns` (jobs in progress keep
   /// their remaining time). With `watch`, stops early at the first instant after which it has
