@@ -69,6 +69,15 @@ KEYS = [
     Key("api_round_trip_ns_p50", "ns", "a command (get theta_m) over HTTP on loopback, request to reply, p50"),
     Key("api_round_trip_ns_p99", "ns", "the same, p99"),
     Key("api_memory_100_clients_kb", "kB", "the chimera process's resident memory with 100 clients connected"),
+    Key("dds_raw_array_latency_ns_p50", "ns",
+        "a Float64MultiArray of 9 doubles to another process through raw Cyclone DDS (the bridge's QoS), p50"),
+    Key("dds_raw_array_latency_ns_p99", "ns", "the same, p99"),
+    Key("dds_bridge_latency_ns_p50", "ns", "the same 9 doubles from one table to another through two DDS bridges, p50"),
+    Key("dds_bridge_latency_ns_p99", "ns", "the same, p99"),
+    Key("dds_bridge_latency_p50_ratio", "x", "through the bridges / raw Cyclone DDS, p50"),
+    Key("dds_bridge_latency_p99_ratio", "x", "the same, p99"),
+    Key("dds_stream_latency_p99_ratio", "x",
+        "Figure 4's tasks' release latency p99 with the bridge streaming 100 variables at 1 kHz / without, worst task"),
 ]
 
 KEY_NAMES = [k.name for k in KEYS]
@@ -179,6 +188,17 @@ GOALS = [
          lambda r: (f"{r['api_stream_latency_p99_ratio']:.2f}x with 10 clients"
                     + (f"; command round trip p50 {_fmt(r['api_round_trip_ns_p50'])}, "
                        f"p99 {_fmt(r['api_round_trip_ns_p99'])}" if _have(r, "api_round_trip_ns_p50") else ""))),
+    Goal("a DDS-bridged variable within 1.1x of raw Cyclone DDS (p50 and p99)",
+         ["dds_bridge_latency_p50_ratio", "dds_bridge_latency_p99_ratio"],
+         lambda r: (r["dds_bridge_latency_p50_ratio"] <= 1.1 and r["dds_bridge_latency_p99_ratio"] <= 1.1)
+         if _have(r, "dds_bridge_latency_p50_ratio", "dds_bridge_latency_p99_ratio") else None,
+         lambda r: (f"p50 {_fmt(r['dds_bridge_latency_ns_p50'])} vs {_fmt(r['dds_raw_array_latency_ns_p50'])} "
+                    f"({r['dds_bridge_latency_p50_ratio']:.2f}x); p99 {_fmt(r['dds_bridge_latency_ns_p99'])} vs "
+                    f"{_fmt(r['dds_raw_array_latency_ns_p99'])} ({r['dds_bridge_latency_p99_ratio']:.2f}x)")),
+    Goal("the DDS bridge streaming 100 variables at 1 kHz costs the real-time tasks' release latency p99 at most 1.05x",
+         ["dds_stream_latency_p99_ratio"],
+         lambda r: r["dds_stream_latency_p99_ratio"] <= 1.05 if _have(r, "dds_stream_latency_p99_ratio") else None,
+         lambda r: f"{r['dds_stream_latency_p99_ratio']:.2f}x"),
     Goal("virtual-clock runs of Figure 4 at >= 100x real time",
          ["virtual_clock_speedup_fig4"],
          lambda r: r["virtual_clock_speedup_fig4"] >= 100 if _have(r, "virtual_clock_speedup_fig4") else None,

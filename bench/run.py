@@ -29,6 +29,7 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 sys.path.insert(0, str(HERE))
 import goals  # noqa: E402
+import dds_bridge  # noqa: E402
 
 
 @dataclass
@@ -314,6 +315,12 @@ PROGRAMS = [
     Program("network_api", "apps/chimera/chimera", "the control API under load: 10 clients streaming, round trips, 100 clients",
             ["api_stream_latency_p99_ratio", "api_round_trip_ns_p50", "api_round_trip_ns_p99",
              "api_memory_100_clients_kb"], run=run_network_api, timeout_s=300),
+    Program("dds_bridge", "dds_bridge_ipc", "the DDS bridge: table to table against raw Cyclone DDS; 100 variables "
+            "streamed beside Figure 4",
+            ["dds_raw_array_latency_ns_p50", "dds_raw_array_latency_ns_p99", "dds_bridge_latency_ns_p50",
+             "dds_bridge_latency_ns_p99", "dds_bridge_latency_p50_ratio", "dds_bridge_latency_p99_ratio",
+             "dds_stream_latency_p99_ratio"],
+            run=lambda build, ctx: dds_bridge.run(build, ctx, run_fragment), timeout_s=600),
     Program("switch", "switch_bench", "10,000 switches at 1 kHz on the real clock",
             ["switch_lost_cycles", "switch_commit_latency_ns_p50", "switch_commit_latency_ns_p99"],
             timeout_s=600),

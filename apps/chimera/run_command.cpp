@@ -180,6 +180,18 @@ std::string dump_directory(const RunArgs& args) {
   return logs != nullptr && *logs != '\0' ? std::string(logs) + "/chimera-dumps" : std::string("chimera-dumps");
 }
 
+// The bridge to other subsystems, its publisher woken by the exports' producers as they publish
+// rather than polling for them.
+Result<std::unique_ptr<RemotePorts>> start_bridge(const SubsystemSpec& spec, Subsystem& subsystem,
+                                                  const std::string& shm_suffix) {
+  RemotePortsOptions bridge_options;
+  bridge_options.exports_written = std::make_shared<WriteWatch>();
+  for (const auto& x : spec.exports)
+    if (auto watched = subsystem.watch_writes(x.variable, bridge_options.exports_written); !watched)
+      spdlog::warn("dds: export {}: {}; it is polled", x.variable, watched.error().message);
+  return RemotePorts::create(spec, spec.name + shm_suffix, std::move(bridge_options));
+}
+
 }  // namespace
 
 int run_command(const RunArgs& args) {
@@ -222,7 +234,7 @@ int run_command(const RunArgs& args) {
   // The resource ports to other subsystems: on their own ordinary threads, attached to the table.
   std::unique_ptr<RemotePorts> remote;
   if (spec->has_remote_variables()) {
-    auto bridge = RemotePorts::create(*spec, spec->name + options.shm_suffix);
+    auto bridge = start_bridge(*spec, subsystem, options.shm_suffix);
     if (!bridge) {
       fmt::print(stderr, "{}: dds: {}\n", spec->file, bridge.error().message);
       subsystem.stop();

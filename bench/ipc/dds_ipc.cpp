@@ -87,12 +87,7 @@ int main(int argc, char** argv) {
   const IpcPlan plan = plan_for(args);
   // Loopback only, unicast discovery; a domain of its own so that no other DDS program here
   // (ROS 2, another run) joins in.
-  ::setenv("CYCLONEDDS_URI",
-           "<CycloneDDS><Domain id=\"any\"><General><Interfaces><NetworkInterface name=\"lo\"/></Interfaces>"
-           "<AllowMulticast>false</AllowMulticast></General><Discovery><ParticipantIndex>auto</ParticipantIndex>"
-           "<MaxAutoParticipantIndex>30</MaxAutoParticipantIndex><Peers><Peer address=\"127.0.0.1\"/></Peers>"
-           "</Discovery></Domain></CycloneDDS>",
-           1);
+  use_cyclone_dds_on_loopback();
   const int domain = 100 + static_cast<int>(::getpid() % 100);
   IpcRun run = run_ipc_latency<DdsPub, DdsSub>(
       plan,

@@ -205,6 +205,17 @@ IpcRun run_ipc_latency(const IpcPlan& plan, const std::function<std::unique_ptr<
   return run;
 }
 
+/// Cyclone DDS on the loopback interface only, with unicast discovery: the VM's own network, and
+/// any other DDS program on it, stay out of the measurement. Before the first participant.
+inline void use_cyclone_dds_on_loopback() {
+  ::setenv("CYCLONEDDS_URI",  // NOLINT(concurrency-mt-unsafe): before any thread
+           "<CycloneDDS><Domain id=\"any\"><General><Interfaces><NetworkInterface name=\"lo\"/></Interfaces>"
+           "<AllowMulticast>false</AllowMulticast></General><Discovery><ParticipantIndex>auto</ParticipantIndex>"
+           "<MaxAutoParticipantIndex>30</MaxAutoParticipantIndex><Peers><Peer address=\"127.0.0.1\"/></Peers>"
+           "</Discovery></Domain></CycloneDDS>",
+           1);
+}
+
 /// Writes the run as a fragment: keys PREFIX_latency_ns_p50 and PREFIX_latency_ns_p99.
 inline int report_ipc(const Args& args, const std::string& prefix, const std::string& what, IpcRun& run,
                       const IpcPlan& plan) {

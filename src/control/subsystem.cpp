@@ -14,6 +14,8 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "chimera/exec/write_watch.hpp"
+
 #include "chimera/svt/global_table.hpp"
 #include "chimera/svt/value_codec.hpp"
 #include "exec/task_block.hpp"
@@ -136,6 +138,8 @@ Result<void> Subsystem::Impl::build_runtime(const std::string& configuration, st
   setup.start_ns = start_ns;
   if (m.block) setup.processes = process_setup(m.spec, m.options, m.block.get(), configuration);
   m.executive = make_executive(std::move(setup));
+  for (const auto& [variable, watch] : m.watches)
+    if (const auto v = m.table->find(variable)) m.executive->watch_writes(*v, watch.get());
   m.reconfiguration = std::make_unique<Reconfiguration>(resolved, configuration, *m.requests, *m.tasks, *m.executive,
                                                         *m.table, *m.events);
   return {};
@@ -297,6 +301,17 @@ const Registry& Subsystem::registry() const { return *impl_->registry; }
 bool Subsystem::illegal_configuration() const {
   std::shared_lock<std::shared_mutex> lock(impl_->runtime_mutex);  // the table goes at stop
   return impl_->table && impl_->table->illegal_configuration();
+}
+
+Result<void> Subsystem::watch_writes(const std::string& variable, std::shared_ptr<WriteWatch> watch) {
+  Impl& m = *impl_;
+  std::lock_guard<std::mutex> lock(m.ops_mutex);
+  if (m.stopped || !m.table) return make_error(Errc::kState, "the subsystem is stopped");
+  const auto v = m.table->find(variable);
+  if (!v) return make_error(Errc::kNotFound, fmt::format("no state variable named '{}'", variable));
+  m.executive->watch_writes(*v, watch.get());
+  m.watches.emplace_back(variable, std::move(watch));  // kept until the Subsystem goes: tasks may ring it until stopped
+  return {};
 }
 
 Result<std::vector<double>> Subsystem::get(std::string_view variable) const {

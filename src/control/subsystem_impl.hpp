@@ -8,6 +8,7 @@
 #include <mutex>
 #include <shared_mutex>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "chimera/control/subsystem.hpp"
@@ -68,6 +69,8 @@ struct Subsystem::Impl {
   std::vector<Event> earlier_events;         // not drained yet
   std::vector<std::string> earlier_faults;   // faults() lines
   std::vector<std::string> left_behind;      // tasks whose thread stop() left behind, stuck in a method
+  // watch_writes(): each variable's watch, applied to every executive build_runtime() makes.
+  std::vector<std::pair<std::string, std::shared_ptr<WriteWatch>>> watches;
   bool earlier_hard_failure = false;
 
   void note_kill(std::size_t task, const Result<void>& killed) {

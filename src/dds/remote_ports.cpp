@@ -8,13 +8,17 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <condition_variable>
+#include <array>
+#include <deque>
 #include <mutex>
 #include <optional>
 #include <set>
 #include <thread>
 
 #include <dds/dds.h>
+#include <poll.h>
+#include <sys/eventfd.h>
+#include <unistd.h>
 #include <fmt/format.h>
 
 #include "chimera/core/duration_text.hpp"
@@ -70,11 +74,19 @@ struct ExportPort {
   std::vector<double> values;
 };
 
+// What an import's listener is given: the bridge and which of its imports.
+struct ListenerArg {
+  RemotePorts::Impl* impl;
+  std::size_t index;
+};
+
 struct ImportPort {
   ImportSpec spec;
   VarIndex index = 0;
   dds_entity_t reader = 0;
-  std::int64_t last_update_ns = 0;             // monotonic, ours; the bridge's start before the first sample
+  // Monotonic, ours; the bridge's start before the first sample. Relaxed everywhere: a time on its
+  // own, written by DDS's listener thread and judged by the taker's.
+  std::atomic<std::int64_t> last_update_ns{0};
   std::set<dds_instance_handle_t> discovered;  // remote writers whose shape was checked (the taker's)
   bool said_stale = false;                     // the taker's: the last change reported was "stale"
   ImportStatus status;                         // guarded by Impl::status_mutex
@@ -100,13 +112,12 @@ struct RemotePorts::Impl {
   GlobalTable table;
   Entity participant;  // deleting it deletes every other entity it made
   std::vector<ExportPort> exports;
-  std::vector<ImportPort> imports;
+  std::deque<ImportPort> imports;
   dds_entity_t waitset = 0;
   dds_entity_t wake = 0;  // a guard condition that ends the taker's wait at shutdown
 
   std::atomic<bool> stopping{false};
-  std::mutex stop_mutex;  // with stop_cv: the publisher's sleep between polls
-  std::condition_variable stop_cv;
+  int stop_fd = -1;  // an eventfd: the destructor ends the publisher's sleep with it
   std::thread publisher;
   std::thread taker;
 
@@ -114,6 +125,7 @@ struct RemotePorts::Impl {
   std::vector<std::string> errors;
   std::vector<std::string> changes;                       // an import's first sample, stale, fresh again
   std::set<std::string> reported;                         // "variable|writer|count" of wrong-size writers already named
+  std::vector<std::unique_ptr<ListenerArg>> listener_args;  // what each import's listener is given
   std::optional<IllegalConfigurationHold> stale_hold;     // the taker's thread only
   std::optional<IllegalConfigurationHold> conflict_hold;  // the taker's thread only
 
@@ -123,6 +135,9 @@ struct RemotePorts::Impl {
   void publish(ExportPort& port);
   void take_loop();
   void take(ImportPort& port);
+  /// From now on each import's samples are taken on DDS's own receive thread, as they arrive:
+  /// one thread hop fewer than a waitset's. Cyclone DDS calls one reader's listener at a time.
+  Result<void> listen_to_imports();
   void take_sample(ImportPort& port, const Msg& msg, const dds_sample_info_t& info);
   Result<void> add_import(const ImportSpec& import, dds_entity_t subscriber, dds_entity_t topic, std::int64_t start);
   void check_echo(ExportPort& port);
@@ -153,14 +168,17 @@ void RemotePorts::Impl::publish(ExportPort& port) {
     report("write|" + port.variable, dds_error(fmt::format("export {}: write", port.variable), rc));
 }
 
+// Sleeps until a producer publishes an export (the watch), the destructor's word, or the poll's
+// time, whichever comes first; then publishes every export whose version moved.
 void RemotePorts::Impl::publish_loop() {
-  std::unique_lock lock(stop_mutex);
+  WriteWatch* const watch = options.exports_written.get();
+  const timespec poll{static_cast<time_t>(options.poll_ns / 1'000'000'000),
+                      static_cast<long>(options.poll_ns % 1'000'000'000)};
   while (!stopping.load(std::memory_order_relaxed)) {  // relaxed: the flag carries no data
-    lock.unlock();
+    if (watch != nullptr) (void)watch->take();         // before the reads: news after it wakes us again
     for (auto& port : exports) publish(port);
-    lock.lock();
-    stop_cv.wait_for(lock, std::chrono::nanoseconds(options.poll_ns),
-                     [&] { return stopping.load(std::memory_order_relaxed); });  // relaxed: as above
+    std::array<pollfd, 2> fds{pollfd{stop_fd, POLLIN, 0}, pollfd{watch != nullptr ? watch->fd() : -1, POLLIN, 0}};
+    (void)::ppoll(fds.data(), fds.size(), &poll, nullptr);
   }
 }
 
@@ -173,6 +191,22 @@ void RemotePorts::Impl::take(ImportPort& port) {
     if (info[0].valid_data) take_sample(port, *static_cast<const Msg*>(samples[0]), info[0]);
     dds_return_loan(port.reader, samples.data(), n);
   }
+}
+
+Result<void> RemotePorts::Impl::listen_to_imports() {
+  for (std::size_t i = 0; i < imports.size(); ++i) {
+    listener_args.push_back(std::make_unique<ListenerArg>(ListenerArg{this, i}));
+    dds_listener_t* listener = dds_create_listener(listener_args.back().get());
+    dds_lset_data_available(listener, [](dds_entity_t /*reader*/, void* arg) {
+      auto* a = static_cast<ListenerArg*>(arg);
+      a->impl->take(a->impl->imports[a->index]);
+    });
+    const dds_return_t rc = dds_set_listener(imports[i].reader, listener);
+    dds_delete_listener(listener);  // the reader keeps its own copy
+    if (rc < 0) return make_error(Errc::kInvalidInput, dds_error(fmt::format("import {}", imports[i].spec.variable), rc));
+    take(imports[i]);  // what came before the listener did
+  }
+  return {};
 }
 
 void RemotePorts::Impl::take_sample(ImportPort& port, const Msg& msg, const dds_sample_info_t& info) {
@@ -189,7 +223,7 @@ void RemotePorts::Impl::take_sample(ImportPort& port, const Msg& msg, const dds_
     return;
   }
   table.write(port.index, msg.data._buffer + offset);
-  port.last_update_ns = monotonic_ns();
+  port.last_update_ns.store(monotonic_ns(), std::memory_order_relaxed);  // relaxed: see its declaration
   std::lock_guard guard(status_mutex);
   if (++port.status.samples == 1)
     changes.push_back(fmt::format("import {}: first sample, from {}", port.spec.variable, who));
@@ -259,13 +293,14 @@ void RemotePorts::Impl::judge_staleness() {
   {
     std::lock_guard guard(status_mutex);
     for (auto& port : imports) {
-      port.status.stale = now - port.last_update_ns > port.spec.max_age_ns;
+      const std::int64_t last = port.last_update_ns.load(std::memory_order_relaxed);  // relaxed: as declared
+      port.status.stale = now - last > port.spec.max_age_ns;
       any_stale = any_stale || port.status.stale;
       if (port.status.stale == port.said_stale) continue;
       port.said_stale = port.status.stale;
       changes.push_back(port.status.stale
                             ? fmt::format("import {}: stale, no sample for {} (max_age){}", port.spec.variable,
-                                          format_duration(now - port.last_update_ns),
+                                          format_duration(now - last),
                                           options.hold_when_stale ? ": the illegal-configuration flag is raised" : "")
                             : fmt::format("import {}: fresh again, from {}", port.spec.variable,
                                           port.status.writer.empty() ? std::string("a writer without a Chimera stamp")
@@ -288,7 +323,6 @@ void RemotePorts::Impl::take_loop() {
         dds_waitset_wait(waitset, triggered.data(), triggered.size(), static_cast<dds_duration_t>(tick));
     for (dds_return_t i = 0; i < n; ++i) {
       const auto which = static_cast<std::size_t>(triggered[static_cast<std::size_t>(i)]);
-      if (which < imports.size()) take(imports[which]);
       if (which > imports.size() && which < first_discovery) check_echo(exports[which - imports.size() - 1]);
       if (which >= first_discovery && which - first_discovery < imports.size())
         check_discovered(imports[which - first_discovery]);
@@ -308,13 +342,14 @@ RemotePorts::RemotePorts(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 
 RemotePorts::~RemotePorts() {
   impl_->stopping.store(true, std::memory_order_relaxed);  // relaxed: the joins below order the rest
-  {
-    std::lock_guard lock(impl_->stop_mutex);  // so the publisher cannot miss the notification
-  }
-  impl_->stop_cv.notify_all();
+  if (impl_->stop_fd >= 0) (void)::eventfd_write(impl_->stop_fd, 1);  // stays readable: the publisher cannot miss it
   if (impl_->wake > 0) dds_set_guardcondition(impl_->wake, true);
   if (impl_->publisher.joinable()) impl_->publisher.join();
   if (impl_->taker.joinable()) impl_->taker.join();
+  // The participant first (it waits for a listener still running), then the ports it writes to.
+  if (impl_->participant.id > 0) dds_delete(impl_->participant.id);
+  impl_->participant.id = 0;
+  if (impl_->stop_fd >= 0) ::close(impl_->stop_fd);
 }
 
 namespace {
@@ -339,10 +374,10 @@ Result<void> check_shape(const GlobalTable& table, const std::string& variable, 
 // writers.
 Result<void> RemotePorts::Impl::add_import(const ImportSpec& import, dds_entity_t subscriber, dds_entity_t topic,
                                            std::int64_t start) {
-  ImportPort port;
+  ImportPort& port = imports.emplace_back();  // in place: a deque never moves it, and a listener holds it
   port.spec = import;
   port.status.variable = import.variable;
-  port.last_update_ns = start;
+  port.last_update_ns.store(start, std::memory_order_relaxed);  // before any thread
   if (auto ok = check_shape(table, import.variable, import.count, "import", port.index); !ok) return ok;
   Qos qos;
   dds_qset_history(qos.q, DDS_HISTORY_KEEP_LAST, 1);
@@ -352,16 +387,15 @@ Result<void> RemotePorts::Impl::add_import(const ImportSpec& import, dds_entity_
   dds_qset_durability(qos.q, import.durability == DdsDurability::kTransientLocal ? DDS_DURABILITY_TRANSIENT_LOCAL
                                                                                  : DDS_DURABILITY_VOLATILE);
   port.reader = topic < 0 ? topic : dds_create_reader(subscriber, topic, qos.q, nullptr);
-  const dds_entity_t ready = port.reader < 0 ? port.reader : dds_create_readcondition(port.reader, DDS_ANY_STATE);
-  if (ready < 0 || dds_waitset_attach(waitset, ready, static_cast<dds_attach_t>(imports.size())) < 0)
-    return make_error(Errc::kInvalidInput, dds_error(fmt::format("import {}", import.variable), ready));
+  if (port.reader < 0) return make_error(Errc::kInvalidInput, dds_error(fmt::format("import {}", import.variable), port.reader));
   // The reader itself, woken only when a writer is matched or lost: its shape is checked then.
+  // Its samples are taken by a listener (listen_to_imports), not through the waitset.
   const dds_return_t mask = dds_set_status_mask(port.reader, DDS_SUBSCRIPTION_MATCHED_STATUS);
   if (mask < 0 ||
       dds_waitset_attach(waitset, port.reader,
-                         static_cast<dds_attach_t>(spec.imports.size() + 1 + spec.exports.size() + imports.size())) < 0)
+                         static_cast<dds_attach_t>(spec.imports.size() + 1 + spec.exports.size() + imports.size() -
+                                                   1)) < 0)
     return make_error(Errc::kInvalidInput, dds_error(fmt::format("import {}: discovery", import.variable), mask));
-  imports.push_back(std::move(port));
   return {};
 }
 
@@ -371,7 +405,7 @@ Result<std::unique_ptr<RemotePorts>> RemotePorts::create(const SubsystemSpec& sp
   if (!table) return table.error();
   auto impl = std::make_unique<Impl>(std::move(*table));
   impl->spec = spec;
-  impl->options = options;
+  impl->options = std::move(options);
   Impl& m = *impl;
 
   m.participant.id = dds_create_participant(static_cast<dds_domainid_t>(spec.dds.domain), nullptr, nullptr);
@@ -383,7 +417,7 @@ Result<std::unique_ptr<RemotePorts>> RemotePorts::create(const SubsystemSpec& sp
   const dds_entity_t subscriber = dds_create_subscriber(m.participant.id, group.q, nullptr);
   if (publisher < 0 || subscriber < 0)
     return make_error(Errc::kInvalidInput, dds_error("publisher and subscriber", std::min(publisher, subscriber)));
-  // Attached to the waitset as: import i's data -> i, the wake-up -> imports.size(), export k's
+  // Attached to the waitset as: (i unused: import i's data goes to a listener), the wake-up -> imports.size(), export k's
   // echo -> imports.size() + 1 + k, import i's discovered writers -> imports.size() + 1 +
   // exports.size() + i.
   m.waitset = dds_create_waitset(m.participant.id);
@@ -428,8 +462,15 @@ Result<std::unique_ptr<RemotePorts>> RemotePorts::create(const SubsystemSpec& sp
   for (const auto& i : spec.imports)
     if (auto added = m.add_import(i, subscriber, topic(i.variable), start); !added) return added.error();
 
+  m.stop_fd = ::eventfd(0, EFD_CLOEXEC);
+  if (m.stop_fd < 0) return make_error(Errc::kSystem, "the bridge's publisher: no eventfd");
   if (!m.exports.empty()) m.publisher = std::thread([&m] { m.publish_loop(); });
   m.taker = std::thread([&m] { m.take_loop(); });  // also the exports' echoes
+  // Last: nothing below may fail, since the listeners run from here on until the participant goes.
+  if (auto listening = m.listen_to_imports(); !listening) {
+    RemotePorts stopped(std::move(impl));  // its destructor stops both threads
+    return listening.error();
+  }
   return std::unique_ptr<RemotePorts>(new RemotePorts(std::move(impl)));
 }
 

@@ -29,6 +29,7 @@
 namespace chimera {
 
 class TaskBlock;
+class WriteWatch;
 
 /// What the main process needs to run tasks in module processes (docs/processes.md).
 struct ProcessSetup {
@@ -143,6 +144,10 @@ class Executive {
   /// The tasks whose thread shutdown() left behind, stuck in a method. Whatever that thread may
   /// still touch (its modules, tasks, this executive, the table) must then outlive the process.
   [[nodiscard]] virtual std::vector<std::string> left_behind() const = 0;
+  /// From now on each publication of variable `v` by a task this process runs calls
+  /// `watch->written()` (nullptr: no more). `watch` must outlive the executive or the next call
+  /// for `v`. The virtual clock calls nothing: its time is not the watcher's. Any thread.
+  virtual void watch_writes(VarIndex v, WriteWatch* watch) = 0;
 };
 
 /// The shortest period among the periodic tasks that leave or join in `commit` (0: none): a

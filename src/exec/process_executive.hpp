@@ -47,6 +47,8 @@ class ProcessExecutive final : public Executive {
   void shutdown() override;
   void begin_stop() override { local_->begin_stop(); }  // a module process's stuck task: its process is killed
   [[nodiscard]] std::vector<std::string> left_behind() const override { return local_->left_behind(); }
+  // Only the tasks of the main process: a worker's publications are found by the watcher's own poll.
+  void watch_writes(VarIndex v, WriteWatch* watch) override { local_->watch_writes(v, watch); }
 
  private:
   /// The module process that runs task `task`, or nullptr for the main process.

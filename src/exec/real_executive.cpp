@@ -20,6 +20,7 @@
 #include "chimera/core/duration_text.hpp"
 #include "chimera/core/invariant.hpp"
 #include "chimera/exec/clock.hpp"
+#include "chimera/exec/write_watch.hpp"
 #include "futex.hpp"
 #include "priority_dispatcher.hpp"
 #include "real_worker.hpp"
@@ -120,6 +121,7 @@ RealExecutive::RealExecutive(ExecutiveSetup setup)
       epoch_ns_(setup.epoch_ns != 0 ? setup.epoch_ns : monotonic_ns() - setup.start_ns),
       realtime_(setup.realtime_priorities) {
   prepare_realtime_process(realtime_);
+  watches_ = std::vector<std::atomic<WriteWatch*>>(table_->size());  // value-initialized: none
   for (Task* t : tasks_) {
     t->set_virtual_clock(false);
     if (setup.measure_cpu_time || t->spec().wcet_ns) t->set_exec_clock(Task::ExecClock::kCpu);
@@ -224,6 +226,10 @@ RealExecutive::~RealExecutive() { shutdown(); }
 void RealExecutive::begin_stop() {
   std::lock_guard<std::mutex> lock(control_mutex_);
   reply_timeout_ns_ = std::min(reply_timeout_ns_, kStopReplyTimeoutNs);
+}
+
+void RealExecutive::watch_writes(VarIndex v, WriteWatch* watch) {
+  watches_[v].store(watch, std::memory_order_release);  // release: the watch is whole before a task sees it
 }
 
 std::vector<std::string> RealExecutive::left_behind() const {

@@ -53,6 +53,11 @@ class RealExecutive final : public Executive {
   void shutdown() override;
   void begin_stop() override;
   [[nodiscard]] std::vector<std::string> left_behind() const override;
+  void watch_writes(VarIndex v, WriteWatch* watch) override;
+  /// The watch of variable `v`, if any. Real-time safe.
+  [[nodiscard]] WriteWatch* watch_of(int v) const noexcept {
+    return watches_[static_cast<std::size_t>(v)].load(std::memory_order_acquire);  // acquire: the watch is whole
+  }
 
   /// CLOCK_MONOTONIC at the executive's time 0. Real-time safe.
   [[nodiscard]] std::int64_t epoch_ns() const noexcept { return epoch_ns_; }
@@ -106,6 +111,7 @@ class RealExecutive final : public Executive {
   std::int64_t epoch_ns_ = 0;
   bool realtime_ = false;
   std::mutex control_mutex_;  // one control request at a time; never taken by a task's thread
+  std::vector<std::atomic<WriteWatch*>> watches_;  // one a variable of the table, nullptr: none; never resized
   std::int64_t reply_timeout_ns_ = 10'000'000'000;  // the control thread's: how long a signal waits for its answer
 
   // The service thread (service_thread.cpp) and what its overrun watch holds.

@@ -9,6 +9,7 @@
 #include <optional>
 
 #include "chimera/exec/clock.hpp"
+#include "chimera/exec/write_watch.hpp"
 #include "futex.hpp"
 #include "priority_dispatcher.hpp"
 #include "real_executive.hpp"
@@ -178,6 +179,8 @@ std::int64_t Worker::run_job(std::int64_t release_abs) {
   (void)task->begin_job(release_abs - epoch, start - epoch);
   const std::int64_t used = task->end_job(monotonic_ns() - epoch, -1);
   running_deadline_ns.store(kNever, std::memory_order_relaxed);  // relaxed: as above
+  for (const int v : out_vars)
+    if (WriteWatch* watch = exec->watch_of(v); watch != nullptr) watch->written();  // the DDS bridge's exports
   for (Worker* s : subscribers) {
     const int v = s->wake.trigger_var.load(std::memory_order_relaxed);  // a hint; the flag below orders
     if (v < 0 || std::find(out_vars.begin(), out_vars.end(), v) == out_vars.end()) continue;

@@ -51,6 +51,7 @@ class VirtualExecutive final : public Executive {
   // left behind that could be waited for.
   void begin_stop() override {}
   [[nodiscard]] std::vector<std::string> left_behind() const override { return {}; }
+  void watch_writes(VarIndex /*v*/, WriteWatch* /*watch*/) override {}
 
   /// Runs every event before `end_ns`, then sets the time to `end_ns` (jobs in progress keep
   /// their remaining time). With `watch`, stops early at the first instant after which it has

@@ -24,6 +24,8 @@
 
 namespace chimera {
 
+class WriteWatch;
+
 struct RunOptions {
   ClockKind clock = ClockKind::kReal;
   std::optional<std::string> configuration;  // default: the file's start configuration
@@ -120,6 +122,12 @@ class Subsystem {
   [[nodiscard]] const Registry& registry() const;
   /// Whether the illegal-configuration flag is up now (paper 3.4). Any thread.
   [[nodiscard]] bool illegal_configuration() const;
+  /// From now on until the stop, `watch` is woken each time a task of this process publishes
+  /// `variable` (chimera/exec/write_watch.hpp), also after the live assembly rebuilds the runtime:
+  /// how the DDS bridge learns of its exports' new values without polling the table. Tasks in
+  /// module processes wake nobody. Refuses a variable the table does not hold. Call it from the
+  /// thread that drives the commands. Not real-time safe.
+  Result<void> watch_writes(const std::string& variable, std::shared_ptr<WriteWatch> watch);
 
   // The live assembly (docs/control-api.md, "Live assembly"), what ros2_control users do with
   // load, configure and switch. Each refuses, changing nothing, what it cannot carry out, with one

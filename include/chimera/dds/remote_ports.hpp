@@ -12,12 +12,16 @@
 
 #include "chimera/config/subsystem.hpp"
 #include "chimera/core/result.hpp"
+#include "chimera/exec/write_watch.hpp"
 
 namespace chimera {
 
 struct RemotePortsOptions {
-  /// How often the publishing thread looks for new values of the exports.
+  /// How often the publishing thread looks for new values of the exports, at the least.
   std::int64_t poll_ns = 1'000'000;
+  /// Woken by the exports' producers (Subsystem::watch_writes): the publishing thread then
+  /// publishes at once rather than at its next poll. None: the poll alone.
+  std::shared_ptr<WriteWatch> exports_written;
   /// Raise the illegal-configuration flag while any import is stale, so that the robot
   /// interfaces hold the arm (paper 3.4) when the machine that feeds them drops off.
   bool hold_when_stale = true;

@@ -2,6 +2,8 @@
 // with real threads. Behaviour only; timing figures live in the benchmarks.
 
 #include <arpa/inet.h>
+#include <poll.h>
+#include <sys/eventfd.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -15,6 +17,7 @@
 
 #include "chimera/config/loader.hpp"
 #include "chimera/control/subsystem.hpp"
+#include "chimera/exec/write_watch.hpp"
 #include "support/trace_module.hpp"
 
 namespace chimera {
@@ -57,6 +60,49 @@ TEST(RealExecutive, RunsSignalsAndStopsCleanly) {
   s->stop();
   EXPECT_EQ(testing::calls()["p"][testing::kOff], 1);
   EXPECT_EQ(testing::calls()["p"][testing::kKill], 1);
+}
+
+// One eventfd write a wake, however often the producers publish before the watcher takes the news.
+TEST(WriteWatch, WakesOnceUntilTheNewsIsTaken) {
+  WriteWatch watch;
+  ASSERT_GE(watch.fd(), 0);
+  EXPECT_FALSE(watch.take());
+  watch.written();
+  watch.written();
+  pollfd p{watch.fd(), POLLIN, 0};
+  EXPECT_EQ(::poll(&p, 1, 0), 1);
+  EXPECT_TRUE(watch.take());
+  EXPECT_EQ(::poll(&p, 1, 0), 0) << "taken: the eventfd is empty";
+  EXPECT_FALSE(watch.take());
+  watch.written();
+  eventfd_t count = 0;
+  ASSERT_EQ(::eventfd_read(watch.fd(), &count), 0);
+  EXPECT_EQ(count, 1U);
+}
+
+// The DDS bridge's wake: a watched variable's producer rings the watch as it publishes, and
+// only while it runs.
+TEST(RealExecutive, AWatchedVariableWakesItsWatcherAsItsProducerPublishes) {
+  auto s = make("  - {name: c, module: counter, period: 2ms, criticality: soft}\n");
+  auto watch = std::make_shared<WriteWatch>();
+  ASSERT_TRUE(s->watch_writes("count", watch).ok());
+  const auto unknown = s->watch_writes("nosuch", watch);
+  ASSERT_FALSE(unknown.ok());
+  EXPECT_EQ(unknown.error().message, "no state variable named 'nosuch'");
+  ASSERT_TRUE(s->start().ok());
+  pollfd p{watch->fd(), POLLIN, 0};
+  ASSERT_EQ(::poll(&p, 1, 30'000), 1) << "no wake within 30 s";
+  EXPECT_TRUE(watch->take());
+  EXPECT_GE(s->get("count")->at(0), 1.0) << "what woke us is there to read";
+
+  ASSERT_TRUE(s->signal("c", Signal::kOff).ok());
+  (void)watch->take();  // a publication before the off took effect
+  s->run_for(100 * kMs);
+  EXPECT_EQ(::poll(&p, 1, 0), 0) << "an OFF task publishes nothing";
+  EXPECT_FALSE(watch->take());
+  ASSERT_TRUE(s->signal("c", Signal::kOn).ok());
+  EXPECT_EQ(::poll(&p, 1, 30'000), 1) << "no wake within 30 s after on";
+  s->stop();
 }
 
 TEST(RealExecutive, AFailingTaskGoesToErrorAndTheOtherRunsOn) {
