@@ -378,9 +378,7 @@ void ProcessExecutive::supervise() {
 }
 
 std::int64_t ProcessExecutive::stuck_bound_ns(const Task& task, BusyIn method) {
-  if (method != BusyIn::kCycle) return kStuckMethodNs;
-  const std::int64_t span = std::max(task.period_ns(), task.spec().deadline_ns);
-  return std::max(kStuckPeriods * span, kStuckCycleFloorNs);
+  return StuckBound::of(method, task.period_ns(), task.spec().deadline_ns);
 }
 
 void ProcessExecutive::check_heartbeats(std::vector<Watch>& watches) {
@@ -390,7 +388,7 @@ void ProcessExecutive::check_heartbeats(std::vector<Watch>& watches) {
     for (const std::size_t i : w.process->tasks()) {
       const TaskShared& slot = *block_->slot(i);
       const std::int64_t since = slot.busy_since_ns.load(std::memory_order_acquire);  // acquire: pairs with BusyScope
-      if (since == TaskShared::kIdle) continue;
+      if (since <= TaskShared::kGivenUp) continue;                         // idle (a module process gives nothing up)
       const BusyIn method = slot.busy_in.load(std::memory_order_relaxed);  // ordered by the acquire above
       const std::int64_t busy = now - since;
       if (busy <= stuck_bound_ns(*tasks_[i], method)) continue;

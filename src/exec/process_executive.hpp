@@ -73,16 +73,9 @@ class ProcessExecutive final : public Executive {
     int pidfd;
     bool killed;  // for a stuck task: its end is on the way
   };
-  /// The heartbeat: a task of a module process inside one method longer than this is stuck.
+  /// How often the supervisor reads the heartbeats; a task inside one method longer than
+  /// StuckBound (task_shared.hpp) is stuck.
   static constexpr int kHeartbeatTickMs = 10;
-  static constexpr std::int64_t kStuckPeriods = 10;                   // cycle(): ten periods (or deadlines),
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-  // A sanitized worker takes far longer over everything, dying included (its reports).
-  static constexpr std::int64_t kStuckCycleFloorNs = 3'000'000'000;   // and at least 3 s
-#else
-  static constexpr std::int64_t kStuckCycleFloorNs = 200'000'000;     // and at least 200 ms
-#endif
-  static constexpr std::int64_t kStuckMethodNs = 10'000'000'000;      // init, on, off...: 10 s
   [[nodiscard]] static std::int64_t stuck_bound_ns(const Task& task, BusyIn method);
   /// The supervisor thread's body: poll every running process's pidfd, and every tick look at
   /// their tasks' heartbeats.

@@ -218,6 +218,7 @@ void RealExecutive::form_threads() {
     }
     t->members.push_back(&w);
     w.thread = t;
+    w.group = static_cast<int>(threads_.size());  // the thread's number, from 1: it stays when a watch moves it
   }
 }
 
@@ -236,7 +237,8 @@ std::vector<std::string> RealExecutive::left_behind() const {
   std::vector<std::string> names;
   for (const auto& t : threads_)
     if (t->left_behind)
-      for (const Worker* w : t->members) names.push_back(w->task->name());
+      for (const Worker* w : t->members)
+        if (w->thread == t.get()) names.push_back(w->task->name());  // not those moved off it
   return names;
 }
 
@@ -254,12 +256,12 @@ void RealExecutive::shutdown() {
   bool any_left = false;
   for (auto& t : threads_) {
     if (!t->running) continue;
-    if (!t->unanswered) {
+    if (!t->unanswered && !t->given_up) {
       pthread_join(t->handle, nullptr);  // its last member's kill ended it
       continue;
     }
-    // Stuck in a method: it gets as long again to come back, then it is left behind. The
-    // process ends without it; what it may still touch is kept (left_behind()).
+    // Stuck in a method (or in a cycle the watch gave up): it gets as long again to come back, then it is left behind.
+    // The process ends without it; what it may still touch is kept (left_behind()).
     timespec until{};
     clock_gettime(CLOCK_REALTIME, &until);  // pthread_timedjoin_np's clock
     until.tv_sec += kStopReplyTimeoutNs / 1'000'000'000;
@@ -306,10 +308,10 @@ void* thread_entry(void* arg) {
 }
 }  // namespace
 
-Result<void> RealExecutive::start_thread(TaskThread& thread) const {
+Result<void> RealExecutive::start_thread(TaskThread& thread, int alive) const {
   TaskThread& w = thread;
   w.exiting.store(false, std::memory_order_relaxed);  // a new thread; the old one was joined
-  w.alive = 0;                                        // written before the thread exists
+  w.alive = alive;                                    // written before the thread exists
   pthread_attr_t attr;
   pthread_attr_init(&attr);
   pthread_attr_setstacksize(&attr, kStackBytes);
@@ -381,6 +383,11 @@ Result<void> RealExecutive::await(Worker& w, std::uint32_t seq) const {
 }
 
 Result<void> RealExecutive::answering(Worker& w) {
+  if (w.given_up)
+    return make_error(Errc::kState,
+                      fmt::format("{}: stuck in cycle(), and given up: a task of the main process cannot be "
+                                  "stopped or restarted; run a module you do not trust in a module process (process:)",
+                                  w.task->name()));
   TaskThread& t = *w.thread;
   if (!t.unanswered) return {};
   // Caught up: every member's last mail answered (acquire: what it did before answering is seen).

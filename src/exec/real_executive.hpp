@@ -78,7 +78,8 @@ class RealExecutive final : public Executive {
   void link_workers();
   void make_dispatchers(const SchedulePlan& plan);
   void form_threads();
-  Result<void> start_thread(TaskThread& thread) const;
+  /// Starts `thread`, whose members `alive` are spawned already (a watch's move), 0 otherwise.
+  Result<void> start_thread(TaskThread& thread, int alive = 0) const;
   /// Posts `mail` to a task's thread and waits for its answer.
   Result<void> post(Worker& w, Mail mail);
   /// Posts `mail` to several tasks' threads at once, then waits for every answer.
@@ -96,6 +97,13 @@ class RealExecutive final : public Executive {
   /// The service thread's body, and one look at every task's running job (service_thread.cpp).
   void service_main(const ServiceHooks& hooks);
   void watch_overruns();
+  /// The stuck-task watch (stuck_cycles.cpp), in the main process only: a task of this process
+  /// inside cycle() longer than StuckBound is ERROR, its thread-mates move to a new thread, and
+  /// its own thread drops to SCHED_IDLE. The service thread's.
+  void give_up_stuck_cycles();
+  void give_up(Worker& w, std::int64_t since_ns, std::int64_t now_ns);
+  /// A given-up thread back at SCHED_IDLE, should a dispatcher's ranking have raised it again.
+  void keep_given_up_idle();
 
   const ResolvedSubsystem& subsystem_;
   GlobalTable* table_;
@@ -123,6 +131,7 @@ class RealExecutive final : public Executive {
   // illegal-configuration flag (a hard task's). The service thread's own.
   std::vector<std::int64_t> overdue_reported_;
   std::vector<bool> overdue_hold_;
+  bool gave_up_any_ = false;         // the service thread's: a stuck cycle was given up (stuck_cycles.cpp)
   std::int64_t stopped_at_ns_ = -1;  // after shutdown()
 };
 

@@ -177,6 +177,10 @@ std::int64_t Worker::run_job(std::int64_t release_abs) {
   // Relaxed: a status word, read on its own by the overrun watch; nothing is published with it.
   running_deadline_ns.store(task->absolute_deadline(release_abs - epoch), std::memory_order_relaxed);
   (void)task->begin_job(release_abs - epoch, start - epoch);
+  if (task->given_up()) {  // stuck, and given up while it was: nothing more of it is ours
+    running_deadline_ns.store(kNever, std::memory_order_relaxed);  // relaxed: as above
+    return 0;
+  }
   const std::int64_t used = task->end_job(monotonic_ns() - epoch, -1);
   running_deadline_ns.store(kNever, std::memory_order_relaxed);  // relaxed: as above
   for (const int v : out_vars)
@@ -237,6 +241,7 @@ void Worker::act() {
   if (dispatcher != nullptr) publish_job(release_abs);
   wait_for_predecessors(schedule.k, release_abs);
   (void)run_job(release_abs);
+  if (task->given_up()) return;  // its thread leaves it, and its thread-mates, alone now
   schedule.last_run = schedule.k;
   // seq_cst store, then seq_cst load of `waiters`: with the successor's seq_cst increment and
   // re-check this is Dekker's pattern, so either it sees our store or we see it waiting.
@@ -305,7 +310,7 @@ void Worker::wait_for_predecessors(std::int64_t release, std::int64_t release_ab
       const bool on = joining || p->task->state() == TaskState::kOn;
       // acquire: pairs with its store of the release it is about to run
       const std::int64_t next = joining ? joins : p->precedence.scheduled.load(std::memory_order_acquire);
-      if (p->thread == thread) {
+      if (p->group == group) {
         // A producer on this thread has had its turn in this pass (it comes first in data-flow
         // order); if it has not run the release it is behind, and can only catch up once we
         // return: waiting would be waiting for ourselves, until the bound. Counted like a wait

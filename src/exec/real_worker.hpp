@@ -42,6 +42,7 @@ struct TaskThread {
   std::atomic<bool> exiting{false};  // set before the answer to the mail that killed its last member
   bool unanswered = false;           // the control thread's: a mail went unanswered (a method is stuck)
   bool left_behind = false;          // the control thread's: shutdown() gave up joining it
+  bool given_up = false;             // the control thread's: stuck in a member's cycle(), its other members moved
 
   /// The body: until no member is alive.
   void main();
@@ -81,7 +82,12 @@ struct Worker {
   int fixed_priority = 1;                    // SCHED_FIFO priority under rm / dm (and at start)
   PriorityDispatcher* dispatcher = nullptr;  // edf / muf: who ranks its jobs
   int bell_fd = -1;                          // aperiodic: eventfd rung by signals and producers
-  TaskThread* thread = nullptr;              // the thread that runs it
+  // The thread that runs it: changed only when the stuck-task watch moves it off a stuck thread,
+  // under the control mutex and before the new thread starts. Other tasks' threads compare
+  // `group` instead, which never changes.
+  TaskThread* thread = nullptr;
+  int group = -1;         // its first thread's number: tasks that share a thread, or did, in data-flow order
+  bool given_up = false;  // the control thread's view (under the control mutex): its cycle was given up
 
   /// Requests from the control thread and the answers of the task's thread.
   struct Mailbox {

@@ -24,7 +24,8 @@ const char* hook_name(std::uint8_t hook) {
 }  // namespace
 
 const char* busy_in_name(BusyIn method) noexcept {
-  static constexpr std::array<const char*, 7> kNames = {"init", "on", "cycle", "off", "kill", "clear", "reinit"};
+  static constexpr std::array<const char*, 8> kNames = {"init", "on",    "cycle",  "off",
+                                                        "kill", "clear", "reinit", "error"};
   return kNames[static_cast<std::size_t>(method)];
 }
 
@@ -133,15 +134,21 @@ std::int64_t Task::begin_job(std::int64_t release_ns, std::int64_t start_ns) noe
   timing_.release_ns = release_ns;
   timing_.start_ns = start_ns;
   job_ = Job{true, false, release_ns, start_ns, exec_clock_now()};
-  const BusyScope busy(*shared_, BusyIn::kCycle, start_ns);
   module_->virtual_ns_ = 0;
   local_->pull_in_vars();
+  BusyScope busy(*shared_, BusyIn::kCycle, start_ns);
   // An aperiodic task first takes its event from the resource port, then processes it.
   Hook hook = Hook::kSync;
   Status s = trigger_.any() ? call_raw(Hook::kSync) : Status::ok();
   if (s.is_ok()) {
     hook = Hook::kCycle;
     s = call_raw(Hook::kCycle);
+  }
+  // Given up while stuck in there (give_up_cycle): the task is ERROR, and nothing more of it is ours.
+  if (busy.returned(s.is_ok() ? std::nullopt : std::optional(BusyIn::kError))) {
+    job_.open = false;
+    given_up_ = true;
+    return 0;
   }
   if (!s.is_ok()) {
     local_->push_out_vars(release_ns);  // what the failed method wrote is published, as after any method
@@ -249,7 +256,8 @@ Result<void> Task::apply(Signal signal, std::int64_t now_ns) {
   if (!transition(from, signal))
     return make_error(Errc::kState, fmt::format("{}: cannot {} a task that is {}", spec_.name, signal_name(signal),
                                                 state_name(from)));
-  static constexpr BusyIn kMethodOf[] = {BusyIn::kInit, BusyIn::kOn, BusyIn::kOff, BusyIn::kKill, BusyIn::kClear};
+  static constexpr std::array<BusyIn, 5> kMethodOf = {BusyIn::kInit, BusyIn::kOn, BusyIn::kOff, BusyIn::kKill,
+                                                      BusyIn::kClear};
   const BusyScope busy(*shared_, kMethodOf[static_cast<std::size_t>(signal)], now_ns);
   switch (signal) {
     case Signal::kSpawn: return spawn(now_ns);
@@ -386,6 +394,18 @@ void Task::lose_process(const char* reason, std::int64_t now_ns) noexcept {
   if (before == TaskState::kNotCreated) return;
   if (before != TaskState::kError) set_state(TaskState::kError);
   shared_->events.push(now_ns, "ERROR: ", reason, "; operator intervention required (clear)");
+}
+
+bool Task::give_up_cycle(std::int64_t since_ns, const char* reason, std::int64_t now_ns) noexcept {
+  std::int64_t stamp = since_ns;
+  // acq_rel: acquire sees what the task's thread did before the cycle began; release pairs with
+  // its exchange in BusyScope::returned, which then sees the ERROR set below.
+  if (!shared_->busy_since_ns.compare_exchange_strong(stamp, TaskShared::kGivenUp, std::memory_order_acq_rel,
+                                                      std::memory_order_relaxed))
+    return false;  // that cycle has returned
+  if (state() != TaskState::kError) set_state(TaskState::kError);
+  shared_->events.push(now_ns, "ERROR: ", reason, "");
+  return true;
 }
 
 bool Task::forget_lost_process() noexcept {

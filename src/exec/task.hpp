@@ -16,6 +16,7 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -148,6 +149,26 @@ class Task {
   /// giving `reason`; one already in ERROR keeps its hold. Only once the dead process can no longer
   /// write the task's shared state, from the one thread that handles the death. Not real-time safe.
   void lose_process(const char* reason, std::int64_t now_ns) noexcept;
+  /// The real executive's stuck-task watch, main process only (docs/processes.md): gives up the
+  /// cycle() this task's thread has been inside since `since_ns` (its heartbeat), if it still is.
+  /// The task is ERROR then (holding the flag) with an event giving `reason`, and its thread,
+  /// whenever the cycle returns, leaves it alone (given_up()). False when that cycle has returned
+  /// meanwhile. The watch's thread; not real-time safe.
+  bool give_up_cycle(std::int64_t since_ns, const char* reason, std::int64_t now_ns) noexcept;
+  /// On the task's thread, after begin_job: its cycle was given up while it ran, and this thread
+  /// must touch neither the task nor its thread-mates again.
+  [[nodiscard]] bool given_up() const noexcept { return given_up_; }
+  /// The heartbeat as it stands: the method the task's thread is inside and since when (subsystem
+  /// clock), if any. Any thread.
+  struct Busy {
+    BusyIn method;
+    std::int64_t since_ns;
+  };
+  [[nodiscard]] std::optional<Busy> busy() const noexcept {
+    const std::int64_t since = shared_->busy_since_ns.load(std::memory_order_acquire);  // acquire: pairs with BusyScope
+    if (since <= TaskShared::kGivenUp) return std::nullopt;
+    return Busy{shared_->busy_in.load(std::memory_order_relaxed), since};  // ordered by the acquire above
+  }
   /// Before its process starts again: the task is NOT CREATED (its hold on the flag given back),
   /// ready to be spawned by the new process. Returns whether it existed. Not real-time safe.
   bool forget_lost_process() noexcept;
@@ -203,6 +224,7 @@ class Task {
     std::int64_t start_ns = 0;    // subsystem clock
     std::int64_t exec_start = 0;  // on exec_clock_
   } job_;
+  bool given_up_ = false;            // the task's thread's: see given_up()
   std::uint64_t timing_faults_ = 0;  // recovered ones too: events are sent at 1, 2, 4, 8...
   std::atomic<std::uint64_t> reinits_{0};
   std::array<char, 160> exception_text_{};

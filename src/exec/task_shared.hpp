@@ -10,6 +10,7 @@
 #include <atomic>
 #include <cstdint>
 #include <limits>
+#include <optional>
 
 #include "chimera/exec/stats.hpp"
 #include "chimera/lifecycle/state.hpp"
@@ -17,8 +18,9 @@
 
 namespace chimera {
 
-/// The module method a task's thread is inside (its heartbeat, below).
-enum class BusyIn : std::uint8_t { kInit, kOn, kCycle, kOff, kKill, kClear, kReinit };
+/// The module method a task's thread is inside (its heartbeat, below). kError: error() after a
+/// failed cycle().
+enum class BusyIn : std::uint8_t { kInit, kOn, kCycle, kOff, kKill, kClear, kReinit, kError };
 
 /// The method's name as the module's author wrote it ("cycle").
 const char* busy_in_name(BusyIn method) noexcept;
@@ -26,12 +28,15 @@ const char* busy_in_name(BusyIn method) noexcept;
 struct TaskShared {
   static constexpr std::size_t kEventCapacity = 64;
   static constexpr std::int64_t kIdle = std::numeric_limits<std::int64_t>::min();
+  /// The stamp of a cycle() the stuck-task watch gave up (Task::give_up_cycle): its thread finds
+  /// it when the cycle returns, and from then on leaves the task alone.
+  static constexpr std::int64_t kGivenUp = kIdle + 1;
 
   alignas(64) std::atomic<TaskState> state{TaskState::kNotCreated};
   std::atomic<bool> ever_in_error{false};
   /// The heartbeat (docs/processes.md): since when (subsystem clock) the task's thread has been
   /// inside a module method, and which; kIdle between methods. The supervisor kills a module
-  /// process whose task stays too long in one.
+  /// process whose task stays too long in one; the main process's own stuck cycles are given up.
   std::atomic<std::int64_t> busy_since_ns{kIdle};
   std::atomic<BusyIn> busy_in{BusyIn::kCycle};
   TaskStats stats;
@@ -42,19 +47,56 @@ static_assert(std::atomic<TaskState>::is_always_lock_free, "a task's state is sh
 static_assert(std::atomic<std::uint64_t>::is_always_lock_free, "statistics are shared between processes");
 static_assert(std::atomic<std::int64_t>::is_always_lock_free, "the heartbeat is shared between processes");
 
-/// Stamps the heartbeat for the scope of one module method. Real-time safe: three stores.
+/// How long a task may stay inside one module method before it is taken for stuck: in cycle(),
+/// ten of its periods or deadlines, whichever is longer, and at least 200 ms (3 s in a sanitized
+/// build, which takes far longer over everything); in any other method, 10 s.
+struct StuckBound {
+  static constexpr std::int64_t kPeriods = 10;
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  static constexpr std::int64_t kCycleFloorNs = 3'000'000'000;
+#else
+  static constexpr std::int64_t kCycleFloorNs = 200'000'000;
+#endif
+  static constexpr std::int64_t kMethodNs = 10'000'000'000;
+  [[nodiscard]] static constexpr std::int64_t of(BusyIn method, std::int64_t period_ns, std::int64_t deadline_ns) {
+    if (method != BusyIn::kCycle) return kMethodNs;
+    const std::int64_t span = period_ns > deadline_ns ? period_ns : deadline_ns;
+    return kPeriods * span > kCycleFloorNs ? kPeriods * span : kCycleFloorNs;
+  }
+};
+
+/// Stamps the heartbeat for the scope of one module method. Real-time safe: a few stores.
 class BusyScope {
  public:
-  BusyScope(TaskShared& shared, BusyIn method, std::int64_t now_ns) noexcept : shared_(shared) {
+  BusyScope(TaskShared& shared, BusyIn method, std::int64_t now_ns) noexcept : shared_(shared), since_(now_ns) {
     shared_.busy_in.store(method, std::memory_order_relaxed);  // published by the release below
     shared_.busy_since_ns.store(now_ns, std::memory_order_release);  // release: the method is read with it
   }
-  ~BusyScope() { shared_.busy_since_ns.store(TaskShared::kIdle, std::memory_order_release); }  // release: ordered after the method
+  ~BusyScope() {
+    if (open_)
+      shared_.busy_since_ns.store(TaskShared::kIdle, std::memory_order_release);  // release: ordered after the method
+  }
   BusyScope(const BusyScope&) = delete;
   BusyScope& operator=(const BusyScope&) = delete;
 
+  /// The method has returned. True when the stuck-task watch gave it up while it ran: the task is
+  /// the watch's then, and this thread must leave it alone. With `then`, the stamp goes on as that
+  /// method (error() after a failed cycle) under a value of its own, which no give-up aimed at the
+  /// method that returned can match.
+  [[nodiscard]] bool returned(std::optional<BusyIn> then = std::nullopt) noexcept {
+    open_ = then.has_value();
+    if (then) shared_.busy_in.store(*then, std::memory_order_relaxed);  // published by the exchange below
+    // acq_rel: release orders the method (and `then`) before the new stamp; acquire pairs with the
+    // watch's give-up, so that this thread sees the ERROR it set before leaving the task alone.
+    const std::int64_t was =
+        shared_.busy_since_ns.exchange(then ? since_ + 1 : TaskShared::kIdle, std::memory_order_acq_rel);
+    return was == TaskShared::kGivenUp;
+  }
+
  private:
   TaskShared& shared_;
+  std::int64_t since_;
+  bool open_ = true;
 };
 
 }  // namespace chimera

@@ -35,6 +35,7 @@ void TaskThread::main() {
       continue;
     }
     w.run_aperiodic();
+    if (w.task->given_up()) return;  // stuck in its cycle and given up: the thread ends with it
   }
 }
 
@@ -67,6 +68,9 @@ void TaskThread::run_periodic_members() {
       for (int n = 0; n < kCatchUpPerPass && m->schedule.k != k && m->prepare() <= now; ++n) {
         k = m->schedule.k;
         m->act();
+        // Stuck in its cycle and given up: its thread-mates run on another thread now, and this
+        // one ends without touching any of them again.
+        if (m->task->given_up()) return;
       }
     }
   }

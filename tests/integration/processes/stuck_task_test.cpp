@@ -13,8 +13,10 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "chimera_process.hpp"
+#include "exec/task_shared.hpp"
 #include "run_chimera.hpp"
 
 namespace chimera {
@@ -37,9 +39,9 @@ std::string write_file(const TempDir& dir, const std::string& name) {
                              "  - {name: load, module: cpu_load, period: 1ms, criticality: soft}\n"
                              "  - name: spin\n"
                              "    module: loop_in_cycle\n"
-                             "    period: 2ms\n"
+                             "    period: 100ms\n"
                              "    criticality: soft\n"
-                             "    params: {after: 25}\n");
+                             "    params: {after: 2}\n");
   return path;
 }
 
@@ -53,7 +55,8 @@ void ends_with_the_stuck_task_left_behind(End end) {
   std::vector<std::string> args{"run", file};
   if (end == End::kFor) args.insert(args.end(), {"--for", "500ms"});
   ChimeraProcess run(dir, args);
-  // Stuck from its 25th cycle on (50 ms in); the stop comes well after.
+  // Stuck from its 2nd cycle on (200 ms in); the stop comes after that and before the watch gives
+  // the cycle up (ten periods, 1 s; the test below is of that).
   std::this_thread::sleep_for(std::chrono::milliseconds(700));
   if (end == End::kQuit) run.send("quit\n");
   if (end == End::kSigterm) {
@@ -75,6 +78,50 @@ void ends_with_the_stuck_task_left_behind(End end) {
   const std::string out = run.out();
   EXPECT_NE(out.find("load "), std::string::npos) << out;
   EXPECT_NE(out.find("spin "), std::string::npos) << out;
+}
+
+// The watch (stuck_cycles.cpp): spin, stuck in cycle() from its 25th cycle (50 ms in), shares
+// its thread with load (one CPU and one period under rm). Once it has been inside that cycle ten
+// periods, and at least the floor, it is ERROR and load goes on, on a thread of its own; without
+// the watch load stops with it, after its 25 cycles.
+TEST(StuckTask, AStuckCycleIsGivenUpAndItsThreadMateRunsOn) {
+  TempDir dir;
+  const std::string name = "given_up_" + std::to_string(::getpid());
+  const std::string file = dir.file(name + ".yaml");
+  test::write_text(file, "subsystem: " + name +
+                             "\n"
+                             "plugins: [" FAULTY_PLUGIN
+                             "]\n"
+                             "tasks:\n"
+                             "  - {name: load, module: cpu_load, period: 2ms, cpu: 0, criticality: soft}\n"
+                             "  - {name: spin, module: loop_in_cycle, period: 2ms, cpu: 0, criticality: soft,"
+                             " params: {after: 25}}\n");
+  // The watch gives up at about 50 ms + the floor; load then runs for the last 1.5 s at least.
+  const std::int64_t given_up_ms = 50 + StuckBound::kCycleFloorNs / 1'000'000;
+  const std::int64_t run_ms = given_up_ms + 1'500;
+  const std::string stats = dir.file("stats.json");
+  ChimeraProcess run(dir, {"run", file, "--for", std::to_string(run_ms) + "ms", "--stats-json", stats});
+  // Once given up, the task cannot be signalled: clear is refused at once, and says why.
+  std::this_thread::sleep_for(std::chrono::milliseconds(given_up_ms + 500));
+  run.send("clear spin\n");
+  const int code = run.wait_exit(kEndsWithinMs + static_cast<int>(run_ms));
+  ASSERT_NE(code, -1) << "the run did not end\n" << run.err();
+  EXPECT_NE((run.out() + run.err())
+                .find("spin: stuck in cycle(), and given up: a task of the main process cannot be "
+                      "stopped or restarted"),
+            std::string::npos)
+      << run.out() << run.err();
+  EXPECT_EQ(code, 1) << run.err();  // spin's thread is left behind at the stop, still in its cycle
+  const std::string err = run.err();
+  EXPECT_NE(err.find("ERROR: stuck in cycle() for"), std::string::npos) << err;
+  EXPECT_NE(err.find("given up: its thread drops to SCHED_IDLE, and load moved to a new thread"), std::string::npos)
+      << err;
+  const auto doc = nlohmann::json::parse(test::read_text(stats));
+  EXPECT_EQ(doc.at("tasks").at("spin").at("state"), "ERROR");
+  EXPECT_EQ(doc.at("tasks").at("load").at("state"), "ON");  // the statistics are of the run, before the stop
+  // 750 cycles in the last 1.5 s alone; a loaded machine may run fewer, never only the first 25.
+  EXPECT_GE(doc.at("tasks").at("load").at("cycles").get<long>(), 300) << run.out();
+  EXPECT_FALSE(std::filesystem::exists("/dev/shm/chimera_" + name)) << "the region was left behind";
 }
 
 TEST(StuckTask, ForEndsTheRunWithTheStuckTaskLeftBehind) { ends_with_the_stuck_task_left_behind(End::kFor); }
