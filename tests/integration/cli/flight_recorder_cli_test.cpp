@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include "run_chimera.hpp"
 
@@ -49,6 +50,39 @@ std::string the_dump(const std::string& dumps) {
   std::error_code ec;
   for (const auto& entry : fs::directory_iterator(dumps, ec)) made = entry.path().string();
   return made;
+}
+
+// Three hard tasks on one CPU whose 200th cycles overrun: the first misses its deadline and the two
+// behind it miss theirs, a few milliseconds apart. They entered ERROR together: one dump for the
+// three, not a dump each (with thousands of tasks failing at once a dump each held the run for
+// minutes), naming all three.
+TEST(FlightRecorderCli, TasksEnteringErrorTogetherShareOneDump) {
+  TempDir dir;
+  const std::string path = dir.file("three.yaml");
+  std::string text = "subsystem: recorder3_" + std::to_string(::getpid()) + "\ncpus: [0]\ntasks:\n";
+  for (int i = 0; i < 3; ++i)
+    text += "  - {name: load" + std::to_string(i) +
+            ", module: cpu_load, period: 1ms, criticality: hard, params: {exec: 0.0001, overrun_every: 200, "
+            "overrun: 0.002}}\n";
+  write_text(path, text);
+  const std::string dumps = dir.file("dumps");
+  const Outcome o = run_chimera(dir, "run " + quoted(path) + " --clock virtual --for 500ms --record 100ms --dump-dir " +
+                                         quoted(dumps));
+  EXPECT_EQ(o.exit_code, 1) << o.err;
+  std::vector<std::string> made;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dumps, ec)) made.push_back(entry.path().string());
+  ASSERT_EQ(made.size(), 1U) << o.err;
+  EXPECT_NE(made[0].find("-load0-and-2-more-t"), std::string::npos) << made[0];
+  const std::string summary = read_text(made[0] + "/summary.txt");
+  EXPECT_NE(summary.find("why: load0 entered ERROR: "), std::string::npos) << summary;
+  EXPECT_NE(summary.find("; and 2 more with it: load1, load2"), std::string::npos) << summary;
+  for (const char* task : {"load0: ERROR", "load1: ERROR", "load2: ERROR"})
+    EXPECT_NE(summary.find(task), std::string::npos) << summary;
+  EXPECT_NE(o.err.find("load0: flight recorder: the last 0.1 s written to " + made[0] + "/ (2 more tasks entered "
+                                                                                        "ERROR with it)"),
+            std::string::npos)
+      << o.err;
 }
 
 TEST(FlightRecorderCli, AHardTaskEnteringErrorDumpsTheLastSecondsByItself) {
