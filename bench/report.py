@@ -17,6 +17,7 @@ import numpy as np  # noqa: E402
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import analysis  # noqa: E402
 import goals  # noqa: E402
+import history  # noqa: E402
 
 COLOURS = {"chimera": "#1f6fb4", "mutex": "#d62728", "iceoryx": "#2ca02c", "dds": "#9467bd",
            "cyclictest": "#ff7f0e"}
@@ -203,11 +204,19 @@ def write_report(doc, samples, results_dir, name="latest"):
 
     lines += soak_section(results_dir)
 
-    lines += ["## Every key", "", "| key | value | what |", "|---|---|---|"]
+    runs = history.read(results_dir)
+    lines += ["## Every key", "",
+              f"Beside each figure, its lowest and highest over the {len(runs)} full runs recorded in "
+              "[history.jsonl](history.jsonl) (this one included when it is a full run), each with the "
+              "code of its own commit: how far a figure moves from run to run on these shared VMs.", "",
+              "| key | value | over the full runs: lowest – highest (runs) | what |", "|---|---|---|---|"]
     for k in goals.KEYS:
         v = doc.get(k.name)
         why = doc.get("absent", {}).get(k.name, "")
-        lines.append(f"| `{k.name}` | {fmt_value(v, k.unit) if v is not None else 'absent: ' + why} | {k.what} |")
+        over = history.spread(runs, k.name)
+        over_text = f"{fmt_value(over[0], k.unit)} – {fmt_value(over[1], k.unit)} ({over[2]})" if over else "none"
+        lines.append(f"| `{k.name}` | {fmt_value(v, k.unit) if v is not None else 'absent: ' + why} | {over_text} "
+                     f"| {k.what} |")
     lines.append("")
     lines += ["## Reproducing", "",
               "`make bench` (about 5 minutes: it installs the optional `bench` packages of "

@@ -30,6 +30,7 @@ ROOT = HERE.parent
 sys.path.insert(0, str(HERE))
 import goals  # noqa: E402
 import dds_bridge  # noqa: E402
+import history  # noqa: E402
 
 
 @dataclass
@@ -475,6 +476,8 @@ def main():
     name = "latest"
     json_path = results / f"{name}.json"
     json_path.write_text(json.dumps(doc, indent=2) + "\n")
+    if results == HERE / "results" and not only:
+        history.append(doc, results)  # a full run into the committed results: recorded
     import report  # noqa: E402  (needs matplotlib; imported late so that a JSON is written anyway)
     md_path = report.write_report(doc, merged["samples"], results, name)
     print(f"bench: wrote {json_path.relative_to(ROOT) if json_path.is_relative_to(ROOT) else json_path} and "
