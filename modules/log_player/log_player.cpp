@@ -67,7 +67,12 @@ class LogPlayer final : public Module {
   }
 
   Status cycle() override {
-    const double t = static_cast<double>(timing_->release_ns) * 1e-9 + from_s_;
+    // A row of this very instant is due: its time and the release's, each in seconds as a double,
+    // can differ in the last bits (0.699 + 0.064 is not 0.763), so a row is due up to 100 ns
+    // early, far below any period (10 us at least). Without it a row now and then played a
+    // release late.
+    constexpr double kSameInstantS = 1e-7;
+    const double t = static_cast<double>(timing_->release_ns) * 1e-9 + from_s_ + kSameInstantS;
     std::size_t row = next_;
     while (row < times_.size() && times_[row] <= t) ++row;
     if (row == next_) return Status::ok();  // no row came due (or the log has not begun): the outputs hold
