@@ -1,6 +1,7 @@
 #pragma once
 // The subsystem model: plain structs that the YAML loader fills (contract section 1).
 
+#include <algorithm>
 #include <cstdint>
 #include <map>
 #include <optional>
@@ -132,9 +133,7 @@ struct SubsystemSpec {
 
   /// Whether some task runs in a module process (a process other than main).
   [[nodiscard]] bool uses_module_processes() const {
-    for (const auto& t : tasks)
-      if (t.process != kMainProcess) return true;
-    return false;
+    return std::ranges::any_of(tasks, [](const auto& t) { return t.process != kMainProcess; });
   }
 
   std::vector<ExportSpec> exports;  // in file order
