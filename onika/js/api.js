@@ -1,5 +1,5 @@
 // The control API as the page uses it (docs/control-api.md): the token, JSON requests, the
-// shell's commands, and the WebSocket stream of state variables.
+// shell's commands, and the WebSocket streams of state variables, timing and events.
 
 const TOKEN_KEY = 'chimera.token';
 
@@ -64,20 +64,24 @@ export const api = {
 };
 
 /**
- * The latest values of chosen variables at a chosen rate, over /api/stream. The server never
- * queues: a page that draws slowly gets fewer samples, and no task ever waits for it.
- * onSample({seq, t_ns, values}) per frame; onState(text) when the connection changes.
+ * One WebSocket stream of /api/stream (docs/control-api.md, "Streams"): the page names what it
+ * watches, {variables, rate_hz}, {timing_hz, tasks}, {events: true}, and gets frames by kind
+ * ("sample", "timing", "event", "missed"). The server never queues: a page that draws slowly
+ * gets fewer samples, and no task ever waits for it. onFrame(frame) per frame; onState(text)
+ * when the connection changes. With `reconnect`, a stream that closed opens again after a pause.
  */
-export class VariableStream {
-  constructor(onSample, onState) {
-    this.onSample = onSample;
+export class Stream {
+  constructor(onFrame, onState, { reconnect = false } = {}) {
+    this.onFrame = onFrame;
     this.onState = onState;
+    this.reconnect = reconnect;
     this.socket = null;
     this.wanted = null;
+    this.retry = null;
   }
 
-  subscribe(variables, rateHz) {
-    this.wanted = { variables, rate_hz: rateHz };
+  subscribe(wanted) {
+    this.wanted = wanted;
     if (this.socket && this.socket.readyState === WebSocket.OPEN) {
       this.socket.send(JSON.stringify(this.wanted));
       return;
@@ -98,14 +102,18 @@ export class VariableStream {
     socket.onmessage = (event) => {
       const frame = JSON.parse(event.data);
       if (frame.ok === false) this.onState(`stream refused: ${frame.error.message}`);
-      else if (frame.values) this.onSample(frame);
+      else if (frame.kind) this.onFrame(frame);
     };
     socket.onclose = () => {
-      if (this.socket === socket) this.onState('stream closed');
+      if (this.socket !== socket) return; // closed on purpose
+      this.socket = null;
+      this.onState('stream closed');
+      if (this.reconnect) this.retry = setTimeout(() => this.open(), 2000);
     };
   }
 
   close() {
+    clearTimeout(this.retry);
     if (this.socket) {
       const s = this.socket;
       this.socket = null;

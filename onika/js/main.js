@@ -3,15 +3,19 @@
 // commands the shell takes (docs/control-api.md); the page keeps no state the subsystem lacks,
 // except configurations being drawn that have no task yet.
 
-import { api, token, setToken, VariableStream } from './api.js';
+import { api, token, setToken, Stream } from './api.js';
 import { Canvas } from './canvas.js';
 import { el, clear, durationText } from './dom.js';
+import { EventList } from './events.js';
 import { Library, modulePage } from './library.js';
 import { Plot, parseLog } from './plots.js';
 import { TaskTable, timingPage } from './tasks.js';
 
 const $ = (id) => document.getElementById(id);
-const POLL_MS = 500;
+// The status is read again at once when an event says something changed; the poll catches what
+// no event names (a task's figures, the model after another user's edit).
+const POLL_MS = 1000;
+const TIMING_HZ = 2;
 
 const page = {
   model: null,
@@ -21,6 +25,7 @@ const page = {
   compare: '', // the one shown beside it
   drafts: [], // configurations named on the page that have no task yet
   stateKey: '',
+  timingTask: '', // the task whose timing the details show, redrawn at each timing frame
 };
 
 function say(text, kind = 'info') {
@@ -261,6 +266,7 @@ async function renamePort(task, port) {
 }
 
 function showTask(task) {
+  if (page.timingTask) watchTiming('');
   const details = $('details');
   clear(details);
   const c = configuration(page.editing);
@@ -290,22 +296,54 @@ const tasks = new TaskTable($('tasks'), {
   onStats: async (name) => {
     try {
       const reply = await api.command(`stats ${name}`);
-      clear($('details'));
-      $('details').append(timingPage(name, reply.stats));
+      watchTiming(name);
+      showTiming(reply.stats);
     } catch (e) {
       say(`stats ${name}: ${e.message}`, 'error');
     }
   },
 });
 
+/** The timing of page.timingTask in the details, while they show it. */
+function showTiming(stats) {
+  if (!page.timingTask) return;
+  clear($('details'));
+  $('details').append(timingPage(page.timingTask, stats));
+}
+
+/** Follows `name`'s timing on the watch stream ('' for none: events only). */
+function watchTiming(name) {
+  page.timingTask = name;
+  watch.subscribe(name ? { events: true, timing_hz: TIMING_HZ, tasks: [name] } : { events: true });
+}
+
+// What happens, and the tasks' figures, on one stream of their own: state changes redraw the
+// page at once, and the timing in the details follows the task as it runs.
+const events = new EventList($('events'));
+const watch = new Stream(
+  (frame) => {
+    if (frame.kind === 'timing') {
+      if (frame.stats.tasks[page.timingTask]) showTiming(frame.stats);
+      return;
+    }
+    events.add(frame);
+    if (frame.kind === 'missed' || frame.event.type !== 'log') refresh(false);
+  },
+  (text) => ($('events-state').textContent = text === 'streaming' ? '' : text),
+  { reconnect: true },
+);
+
 const plot = new Plot($('plot'));
-const stream = new VariableStream((frame) => plot.addSample(frame), (text) => ($('plot-state').textContent = text));
+const stream = new Stream(
+  (frame) => frame.kind === 'sample' && plot.addSample(frame),
+  (text) => ($('plot-state').textContent = text),
+);
 
 $('plot-live').addEventListener('click', () => {
   const variables = [...$('plot-variables').selectedOptions].map((o) => o.value);
   if (!variables.length) return say('choose the variables to plot', 'error');
   plot.reset(true);
-  stream.subscribe(variables, Number($('plot-rate').value) || 100);
+  stream.subscribe({ variables, rate_hz: Number($('plot-rate').value) || 100 });
 });
 $('plot-stop').addEventListener('click', () => {
   stream.close();
@@ -357,6 +395,7 @@ $('save-close').addEventListener('click', () => $('save-dialog').close());
 
 const library = new Library($('library'), {
   onShow: (m) => {
+    if (page.timingTask) watchTiming('');
     clear($('details'));
     $('details').append(modulePage(m));
   },
@@ -377,6 +416,7 @@ async function start() {
   document.body.dataset.role = page.role;
   library.set(await api.modules());
   await refresh(true);
+  watchTiming('');
   document.body.dataset.ready = 'true';
   setInterval(() => refresh(false), POLL_MS);
 }

@@ -83,7 +83,7 @@ export function timingPage(name, stats) {
   const exec = t.exec_ns || {};
   return el(
     'article',
-    { class: 'timing', 'data-task': name },
+    { class: 'timing', 'data-task': name, 'data-cycles': t.cycles },
     el('h3', {}, `Timing of ${name}`),
     el(
       'table',

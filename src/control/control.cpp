@@ -173,9 +173,11 @@ Reply Control::set(const std::string& variable, const std::vector<double>& value
   return said(format_values(variable, values));
 }
 
-std::string Control::drain_events() {
+std::string Control::drain_events() { return event_lines(subsystem_.drain_events()); }
+
+std::string event_lines(const std::vector<Event>& events) {
   std::string out;
-  for (const auto& e : subsystem_.drain_events()) {
+  for (const auto& e : events) {
     std::string_view text = e.text;
     while (!text.empty() && (text.back() == ' ' || text.back() == '\n')) text.remove_suffix(1);
     if (e.task.empty())

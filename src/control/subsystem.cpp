@@ -252,9 +252,11 @@ std::string Subsystem::configuration() const {
   return impl_->reconfiguration->configuration();
 }
 
-std::vector<SwitchRecord> Subsystem::switches() const {
+std::vector<SwitchRecord> Subsystem::switches(std::size_t first) const {
   std::lock_guard<std::mutex> lock(impl_->ops_mutex);
-  return impl_->reconfiguration->history();
+  const auto& history = impl_->reconfiguration->history();
+  if (first >= history.size()) return {};
+  return {history.begin() + static_cast<std::ptrdiff_t>(first), history.end()};
 }
 
 void Subsystem::stop() {
@@ -347,6 +349,16 @@ Result<void> Subsystem::set(std::string_view variable, const std::vector<double>
   m.table->write(*v, bytes->data());
   m.executive->variable_written(*v);
   return {};
+}
+
+std::vector<std::pair<std::string, TaskState>> Subsystem::states() const {
+  const Impl& m = *impl_;
+  std::shared_lock<std::shared_mutex> runtime(m.runtime_mutex);  // an add replaces the tasks
+  std::vector<std::pair<std::string, TaskState>> out;
+  out.reserve(m.tasks->size());
+  for (std::size_t i = 0; i < m.tasks->size(); ++i)
+    if (!m.is_removed(i)) out.emplace_back((*m.tasks)[i].name(), (*m.tasks)[i].state());
+  return out;
 }
 
 std::vector<TaskSnapshot> Subsystem::snapshot() const {

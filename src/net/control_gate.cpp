@@ -6,17 +6,23 @@ namespace chimera::net {
 
 Reply ControlGate::execute(const Command& command) {
   std::lock_guard<std::mutex> lock(mutex_);
-  return control_.execute(command);
+  Reply reply = control_.execute(command);
+  feed_.observe(subsystem_);
+  return reply;
 }
 
 Reply ControlGate::execute_line(std::string_view line) {
   std::lock_guard<std::mutex> lock(mutex_);
-  return control_.execute_line(line);
+  Reply reply = control_.execute_line(line);
+  feed_.observe(subsystem_);
+  return reply;
 }
 
 std::string ControlGate::drain_events() {
   std::lock_guard<std::mutex> lock(mutex_);
-  return control_.drain_events();
+  const std::vector<Event> events = subsystem_.drain_events();
+  feed_.observe(subsystem_, events);
+  return event_lines(events);
 }
 
 void ControlGate::run_for(std::int64_t ns) {
@@ -29,6 +35,7 @@ void ControlGate::run_for(std::int64_t ns) {
     {
       std::lock_guard<std::mutex> lock(mutex_);
       subsystem_.run_for(step);
+      feed_.observe(subsystem_);  // what simulated time changed (a task entering ERROR), step by step
     }
     ns -= step;
   }

@@ -9,7 +9,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
-#include "chimera/net/variable_streams.hpp"
+#include "chimera/net/api_stream.hpp"
 #include "page_files.hpp"
 
 namespace chimera::net {
@@ -161,8 +161,8 @@ int HttpServer::stream_connect(const mg_connection* conn, void* self) {
 void HttpServer::stream_ready(mg_connection* conn, void* self) {
   auto& server = *static_cast<HttpServer*>(self);
   server.streams_.fetch_add(1, std::memory_order_relaxed);
-  auto* stream = new VariableStream(server.api_.gate(), conn);  // NOLINT(cppcoreguidelines-owning-memory): see below
-  if (!stream->failure().empty()) spdlog::warn("network: a variable stream was refused: {}", stream->failure());
+  auto* stream = new ApiStream(server.api_.gate(), conn);  // NOLINT(cppcoreguidelines-owning-memory): see below
+  if (!stream->failure().empty()) spdlog::warn("network: a stream was refused: {}", stream->failure());
   mg_set_user_connection_data(conn, stream);  // owned until stream_close
 }
 
@@ -170,14 +170,14 @@ int HttpServer::stream_data(mg_connection* conn, int bits, char* data, std::size
   constexpr int kOpcodeMask = 0x0f;
   const int opcode = bits & kOpcodeMask;
   if (opcode == MG_WEBSOCKET_OPCODE_CONNECTION_CLOSE) return 0;
-  auto* stream = static_cast<VariableStream*>(mg_get_user_connection_data(conn));
+  auto* stream = static_cast<ApiStream*>(mg_get_user_connection_data(conn));
   if (opcode == MG_WEBSOCKET_OPCODE_TEXT && stream != nullptr) stream->receive(std::string_view(data, size));
   return 1;
 }
 
 void HttpServer::stream_close(const mg_connection* conn, void* self) {
   auto& server = *static_cast<HttpServer*>(self);
-  auto* stream = static_cast<VariableStream*>(mg_get_user_connection_data(conn));
+  auto* stream = static_cast<ApiStream*>(mg_get_user_connection_data(conn));
   if (stream == nullptr) return;
   delete stream;  // NOLINT(cppcoreguidelines-owning-memory): civetweb holds it as a void* from stream_ready
   mg_set_user_connection_data(conn, nullptr);

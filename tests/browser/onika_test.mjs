@@ -147,6 +147,17 @@ test('assembles Figure 4 from an empty canvas, runs it, plots it and saves a fil
 
     await page.click('#switch');
     for (const task of ['traj', 'pid', 'robot']) await waitForState(page, task, 'ON');
+    // The switch and the states it changed come as events, in the shell's words.
+    await page.waitForSelector('#events li[data-type="switch"]', { timeout: 15000 });
+    assert.match(await page.textContent('#events li[data-type="switch"]'), /switch empty → assembly \(operator\): on [a-z ]*pid/);
+    assert.match(await page.textContent('#events li[data-type="state"][data-task="pid"]'), /pid: NOT-CREATED → ON/);
+
+    // The timing of a task, live: the histogram is there and the cycles go on rising.
+    await page.click('#tasks tr[data-task="pid"] button[data-action="stats"]');
+    await page.waitForSelector('#details article.timing[data-task="pid"] figure.histogram');
+    const cycles = Number(await page.getAttribute('#details article.timing[data-task="pid"]', 'data-cycles'));
+    await page.waitForFunction((seen) => Number(document.querySelector('#details article.timing[data-task="pid"]').dataset.cycles) > seen + 100, cycles, { timeout: 15000 });
+    await page.screenshot({ path: join(shots, 'onika-timing.png') });
     const status = await apiStatus(link);
     assert.equal(status.configuration, 'assembly');
     assert.deepEqual(status.tasks.map((t) => t.state), ['ON', 'ON', 'ON']);
@@ -189,6 +200,9 @@ test('a task in ERROR shows its message and the clear button brings it back', as
     await waitForState(page, 'load', 'ERROR');
     const message = await page.textContent('#tasks tr[data-task="load"] .error-text');
     assert.ok(message.length > 0, 'the ERROR has its message');
+    // The ERROR came as events too: the state change, and the line that says why.
+    await page.waitForSelector('#events li[data-type="log"][data-task="load"]', { timeout: 15000 });
+    assert.match(await page.textContent('#events li[data-type="state"][data-task="load"]'), /load: ON → ERROR/);
     assert.ok(await page.$('#canvas g.task.state-ERROR[data-task="load"]'), 'the canvas shows ERROR by colour');
     await page.screenshot({ path: join(shots, 'onika-error.png') });
     await page.click('#tasks tr[data-task="load"] button[data-action="clear"]');

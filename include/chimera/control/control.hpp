@@ -56,6 +56,9 @@ class Control {
 /// by pid)", "theta_d has more than one producer (ik, integ)"; other rules as verification says.
 std::string violation_reason(const Violation& violation);
 
+/// One line per event, e.g. "robot: ERROR: joint limit" ("" if none): what the shell prints.
+std::string event_lines(const std::vector<Event>& events);
+
 /// The state a task must be in to accept `signal`, for messages ("OFF", "OFF, ON or ERROR").
 std::string_view required_state_text(Signal signal);
 

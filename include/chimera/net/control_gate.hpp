@@ -12,6 +12,7 @@
 
 #include "chimera/control/control.hpp"
 #include "chimera/control/subsystem.hpp"
+#include "chimera/net/event_feed.hpp"
 
 namespace chimera::net {
 
@@ -23,11 +24,20 @@ class ControlGate {
 
   explicit ControlGate(Subsystem& subsystem) : subsystem_(subsystem), control_(subsystem) {}
 
-  /// Control::execute() and execute_line(), one caller at a time. Not real-time safe.
+  /// Control::execute() and execute_line(), one caller at a time; then the feed sees what the
+  /// command changed. Not real-time safe.
   Reply execute(const Command& command);
   Reply execute_line(std::string_view line);
-  /// Control::drain_events(), one caller at a time.
+  /// Control::drain_events(), one caller at a time: the events go into the feed too, with the
+  /// state changes since the last look. Whoever drives the subsystem calls it every few tens of
+  /// milliseconds (the run's loop does, every 50 ms), so the feed is never further behind.
   std::string drain_events();
+
+  /// What happened, for the streams (chimera/net/event_feed.hpp). Any thread.
+  [[nodiscard]] const EventFeed& feed() const { return feed_; }
+  /// The subsystem's figures, without the gate (snapshot() is safe from any thread).
+  [[nodiscard]] std::vector<TaskSnapshot> snapshot() const { return subsystem_.snapshot(); }
+  [[nodiscard]] std::vector<std::pair<std::string, TaskState>> states() const { return subsystem_.states(); }
 
   /// Lets the subsystem run for `ns`. On the virtual clock the caller's thread runs the tasks,
   /// so each step of at most kStepNs holds the gate (other drivers' commands come in between);
@@ -35,11 +45,14 @@ class ControlGate {
   void run_for(std::int64_t ns);
 
   /// Runs `f(control, subsystem)` holding the gate: a command and what the caller reads of the
-  /// subsystem right after it, with no other driver's command in between.
+  /// subsystem right after it, with no other driver's command in between. The feed then sees
+  /// what it changed.
   template <class F>
   auto exclusive(F&& f) {
     std::lock_guard<std::mutex> lock(mutex_);
-    return std::forward<F>(f)(control_, subsystem_);
+    auto result = std::forward<F>(f)(control_, subsystem_);
+    feed_.observe(subsystem_);
+    return result;
   }
 
   /// The current value of a variable, without the gate: Subsystem::get() is safe from any
@@ -53,6 +66,7 @@ class ControlGate {
   Subsystem& subsystem_;
   std::mutex mutex_;  // held for each command; never by a task's thread
   Control control_;
+  EventFeed feed_;  // written under mutex_
 };
 
 }  // namespace chimera::net

@@ -1,11 +1,13 @@
-// WebSocket streams of state variables from a real `chimera run --listen` (real clock): samples
-// at the client's rate, tokens, bad subscriptions, and a stalled client that slows nobody.
+// WebSocket streams from a real `chimera run --listen` (real clock): state variables at the
+// client's rate, the tasks' timing, what happens (state changes, switches, events), tokens, bad
+// subscriptions, and a stalled client that slows nobody.
 
 #include <civetweb.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <condition_variable>
 #include <csignal>
@@ -43,6 +45,20 @@ struct Received {
     arrived.wait_for(lock, std::chrono::seconds(20), [&] { return frames.size() >= count || closed; });
     return frames;
   }
+
+  // Waits until a frame satisfies `wanted` (or the stream closed, or 20 s passed); that frame,
+  // or null.
+  template <class Predicate>
+  json wait_until(Predicate wanted) {
+    std::unique_lock<std::mutex> lock(mutex);
+    json found;
+    arrived.wait_for(lock, std::chrono::seconds(20), [&] {
+      const auto it = std::find_if(frames.begin(), frames.end(), wanted);
+      if (it != frames.end()) found = *it;
+      return it != frames.end() || closed;
+    });
+    return found;
+  }
 };
 
 int on_frame(mg_connection* /*conn*/, int bits, char* data, std::size_t size, void* user) {
@@ -72,6 +88,19 @@ void subscribe(mg_connection* conn, const std::string& text) {
   mg_websocket_client_write(conn, MG_WEBSOCKET_OPCODE_TEXT, text.data(), text.size());
 }
 
+// Opens a stream, subscribes with `subscription`, and returns the first `count` frames (fewer
+// if the stream closed or 20 s passed); the stream is closed again.
+std::vector<json> stream_frames(int port, const std::string& token, const std::string& subscription,
+                                std::size_t count) {
+  Received received;
+  mg_connection* conn = open_stream(port, token, received);
+  if (conn == nullptr) return {};
+  subscribe(conn, subscription);
+  auto frames = received.wait_for(count);
+  mg_close_connection(conn);
+  return frames;
+}
+
 class ControlApiStreamTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -92,21 +121,17 @@ class ControlApiStreamTest : public ::testing::Test {
 
   void TearDown() override {
     process_->send("quit\n");
-    EXPECT_EQ(process_->wait_exit(), 0) << process_->err();
+    EXPECT_EQ(process_->wait_exit(), expected_exit_) << process_->err();
   }
 
   TempDir dir_;
   std::unique_ptr<ChimeraProcess> process_;
   int port_ = 0;
+  int expected_exit_ = 0;  // 1 after a hard task's ERROR, cleared or not (the run's exit code says so)
 };
 
 TEST_F(ControlApiStreamTest, SamplesComeAtTheClientsRate) {
-  Received received;
-  mg_connection* conn = open_stream(port_, kViewer, received);
-  ASSERT_NE(conn, nullptr);
-  subscribe(conn, R"({"variables": ["theta_m", "theta_d"], "rate_hz": 200})");
-  const auto frames = received.wait_for(41);
-  mg_close_connection(conn);
+  const auto frames = stream_frames(port_, kViewer, R"({"variables": ["theta_m", "theta_d"], "rate_hz": 200})", 41);
   ASSERT_GE(frames.size(), 41U);
   EXPECT_EQ(frames[0]["ok"], true) << frames[0];
   EXPECT_EQ(frames[0]["rate_hz"], 200.0);
@@ -181,6 +206,116 @@ TEST_F(ControlApiStreamTest, BadSubscriptionsAreRefusedAndTheStreamGoesOn) {
   EXPECT_EQ(frames[4]["values"]["tau_r"].size(), 6U) << frames[4];
 }
 
+TEST_F(ControlApiStreamTest, TimingComesAtItsRateForTheTasksAsked) {
+  const auto frames = stream_frames(port_, kViewer, R"({"timing_hz": 5, "tasks": ["pid"]})", 4);
+  ASSERT_GE(frames.size(), 4U);
+  EXPECT_EQ(frames[0]["ok"], true) << frames[0];
+  EXPECT_EQ(frames[0]["timing_hz"], 5.0) << frames[0];
+  EXPECT_EQ(frames[0]["rate_hz"], 0.0) << frames[0];
+  std::uint64_t cycles_before = 0;
+  for (std::size_t i = 1; i < frames.size(); ++i) {
+    const json& frame = frames[i];
+    ASSERT_EQ(frame["kind"], "timing") << frame;
+    EXPECT_EQ(frame["seq"], i - 1) << frame;
+    const json& tasks = frame["stats"]["tasks"];
+    ASSERT_EQ(tasks.size(), 1U) << "only the task asked for: " << frame;
+    const json& pid = tasks["pid"];
+    EXPECT_EQ(pid["state"], "ON") << frame;
+    const auto cycles = pid["cycles"].get<std::uint64_t>();
+    EXPECT_GT(cycles, cycles_before) << "pid runs at 1 kHz: more cycles in every frame";
+    cycles_before = cycles;
+    EXPECT_FALSE(pid["histograms"]["latency_ns"].empty()) << frame;
+  }
+  // At 5 Hz, on the stream's own grid from the subscription: the n-th frame (from 0) is sent at
+  // or after n * 200 ms, never sooner (later on a loaded machine).
+  for (std::size_t i = 1; i < frames.size(); ++i)
+    EXPECT_GE(frames[i]["t_ns"].get<std::int64_t>(), static_cast<std::int64_t>(i - 1) * 200'000'000) << frames[i];
+}
+
+TEST_F(ControlApiStreamTest, StateChangesSwitchesAndErrorsComeAsEvents) {
+  Received received;
+  mg_connection* conn = open_stream(port_, kOperator, received);
+  ASSERT_NE(conn, nullptr);
+  subscribe(conn, R"({"events": true})");
+  ASSERT_EQ(received.wait_for(1).at(0)["ok"], true);
+  auto event = [&](const json& wanted) {
+    return received.wait_until([&](const json& frame) {
+      if (frame.value("kind", "") != "event") return false;
+      const json& got = frame.at("event");
+      const auto items = wanted.items();
+      return std::all_of(items.begin(), items.end(), [&](const auto& item) {
+        return got.contains(item.key()) && got.at(item.key()) == item.value();
+      });
+    });
+  };
+
+  ASSERT_EQ(command(port_, kOperator, "off traj").status, 200);
+  EXPECT_FALSE(event({{"type", "state"}, {"task", "traj"}, {"from", "ON"}, {"to", "OFF"}}).is_null());
+  ASSERT_EQ(command(port_, kOperator, "on traj").status, 200);
+  EXPECT_FALSE(event({{"type", "state"}, {"task", "traj"}, {"from", "OFF"}, {"to", "ON"}}).is_null());
+
+  ASSERT_EQ(command(port_, kOperator, "switch loaded").status, 200);
+  const json switched = event({{"type", "switch"}, {"to", "loaded"}});
+  ASSERT_FALSE(switched.is_null());
+  EXPECT_EQ(switched["event"]["from"], "pid_control") << switched;
+  EXPECT_EQ(switched["event"]["on"], json::array({"load"})) << switched;
+  EXPECT_FALSE(event({{"type", "state"}, {"task", "load"}, {"to", "ON"}}).is_null());
+
+  // faulty overruns its budget on every other cycle: a hard task's overrun puts it in ERROR on
+  // its own thread, and the feed sees it at the run's next look, with the event that says why.
+  expected_exit_ = 1;
+  ASSERT_EQ(command(port_, kOperator, "spawn faulty").status, 200);
+  ASSERT_EQ(command(port_, kOperator, "on faulty").status, 200);
+  EXPECT_FALSE(event({{"type", "state"}, {"task", "faulty"}, {"to", "ERROR"}}).is_null());
+  const json why = event({{"type", "log"}, {"task", "faulty"}});
+  ASSERT_FALSE(why.is_null());
+  EXPECT_FALSE(why["event"]["text"].get<std::string>().empty()) << why;
+  ASSERT_EQ(command(port_, kOperator, "clear faulty").status, 200);
+  EXPECT_FALSE(event({{"type", "state"}, {"task", "faulty"}, {"from", "ERROR"}, {"to", "OFF"}}).is_null());
+  mg_close_connection(conn);
+
+  // The numbers rise by one from item to item: nothing was left out between them.
+  std::lock_guard<std::mutex> lock(received.mutex);
+  std::int64_t last = -1;
+  for (const auto& frame : received.frames) {
+    if (frame.value("kind", "") != "event") continue;
+    if (last >= 0) {
+      EXPECT_EQ(frame["seq"].get<std::int64_t>(), last + 1) << frame;
+    }
+    last = frame["seq"].get<std::int64_t>();
+  }
+}
+
+TEST_F(ControlApiStreamTest, SubscriptionsOfTimingAndEventsAreCheckedWhole) {
+  Received received;
+  mg_connection* conn = open_stream(port_, kViewer, received);
+  ASSERT_NE(conn, nullptr);
+  const std::vector<std::pair<std::string, std::string>> refused = {
+      {R"({"variables": ["theta_m"], "rate_hz": 10, "colour": "red"})", "bad_request"},
+      {R"({"rate_hz": 10})", "bad_request"},
+      {R"({"timing_hz": 50})", "bad_request"},
+      {R"({"tasks": ["pid"]})", "bad_request"},
+      {R"({"events": "yes"})", "bad_request"},
+      {R"({})", "bad_request"},
+      {R"({"timing_hz": 1, "tasks": ["pid", "nosuch"]})", "not_found"},
+  };
+  for (std::size_t i = 0; i < refused.size(); ++i) {
+    subscribe(conn, refused[i].first);
+    const auto frames = received.wait_for(i + 1);
+    ASSERT_EQ(frames.size(), i + 1) << refused[i].first;
+    EXPECT_EQ(frames[i]["error"]["code"], refused[i].second) << refused[i].first << ": " << frames[i];
+  }
+  EXPECT_EQ(received.wait_for(refused.size()).back()["error"]["message"], "no task named 'nosuch'");
+  // After all of them the stream takes a good one, the three parts at once.
+  subscribe(conn, R"({"variables": ["theta_m"], "rate_hz": 50, "timing_hz": 2, "events": true})");
+  const json timing = received.wait_until([](const json& f) { return f.value("kind", "") == "timing"; });
+  const json sample = received.wait_until([](const json& f) { return f.value("kind", "") == "sample"; });
+  mg_close_connection(conn);
+  EXPECT_EQ(received.wait_for(refused.size() + 1).at(refused.size())["ok"], true);
+  EXPECT_EQ(timing["stats"]["tasks"].size(), 5U) << "every task without a filter: " << timing;
+  EXPECT_EQ(sample["values"]["theta_m"].size(), 6U) << sample;
+}
+
 TEST_F(ControlApiStreamTest, AStalledStreamSlowsNeitherOtherStreamsNorTasks) {
   // A client that subscribes at 1 kHz and never reads: its bytes pile up until its socket is
   // full and its stream's thread blocks.
@@ -205,12 +340,7 @@ TEST_F(ControlApiStreamTest, AStalledStreamSlowsNeitherOtherStreamsNorTasks) {
     return total;
   };
   const std::uint64_t before = cycles();
-  Received received;
-  mg_connection* conn = open_stream(port_, kViewer, received);
-  ASSERT_NE(conn, nullptr);
-  subscribe(conn, R"({"variables": ["theta_m"], "rate_hz": 100})");
-  const auto frames = received.wait_for(11);
-  mg_close_connection(conn);
+  const auto frames = stream_frames(port_, kViewer, R"({"variables": ["theta_m"], "rate_hz": 100})", 11);
   EXPECT_GE(frames.size(), 11U);
   EXPECT_GT(cycles(), before);
   ::close(fd);
