@@ -23,9 +23,9 @@
 #include "chimera/control/stats_json.hpp"
 #include "chimera/control/subsystem.hpp"
 #include "chimera/control/timing_table.hpp"
-#include "chimera/dds/remote_ports.hpp"
 #include "chimera/module/registry.hpp"
 #include "commands.hpp"
+#include "dds_bridge.hpp"
 #include "exit_codes.hpp"
 #include "line_reader.hpp"
 #include "load_file.hpp"
@@ -72,7 +72,7 @@ Result<void> check_writable(const std::string& path) {
 /// The loop between start and stop: commands in, replies and events out, time kept.
 class Session {
  public:
-  Session(Subsystem& subsystem, net::ControlGate& control, RemotePorts* remote, const RunArgs& args, bool interactive)
+  Session(Subsystem& subsystem, net::ControlGate& control, DdsBridge* remote, const RunArgs& args, bool interactive)
       : subsystem_(subsystem), control_(control), remote_(remote), args_(args), interactive_(interactive) {}
 
   void run() {
@@ -131,10 +131,8 @@ class Session {
   void print_events(bool& prompt_shown) {
     std::string events = control_.drain_events();
     // The bridge's news among the subsystem's own: an import stale or back, a remote refused.
-    if (remote_ != nullptr) {
-      for (const auto& line : remote_->take_errors()) events += "dds: " + line + "\n";
-      for (const auto& line : remote_->take_changes()) events += "dds: " + line + "\n";
-    }
+    if (remote_ != nullptr)
+      for (const auto& line : remote_->poll()) events += "dds: " + line + "\n";
     if (events.empty()) return;
     // Keep the operator's prompt usable: events go on their own lines, then the prompt again.
     if (prompt_shown) out("\n");
@@ -166,7 +164,7 @@ class Session {
 
   Subsystem& subsystem_;
   net::ControlGate& control_;  // shared with the network API
-  RemotePorts* remote_;        // the bridge to other subsystems, or none
+  DdsBridge* remote_;          // the bridge to other subsystems, or none
   const RunArgs& args_;
   bool interactive_;
 };
@@ -178,18 +176,6 @@ std::string dump_directory(const RunArgs& args) {
   // NOLINTNEXTLINE(concurrency-mt-unsafe): read before any thread of the run starts
   const char* logs = std::getenv("CHIMERA_LOG_DIR");
   return logs != nullptr && *logs != '\0' ? std::string(logs) + "/chimera-dumps" : std::string("chimera-dumps");
-}
-
-// The bridge to other subsystems, its publisher woken by the exports' producers as they publish
-// rather than polling for them.
-Result<std::unique_ptr<RemotePorts>> start_bridge(const SubsystemSpec& spec, Subsystem& subsystem,
-                                                  const std::string& shm_suffix) {
-  RemotePortsOptions bridge_options;
-  bridge_options.exports_written = std::make_shared<WriteWatch>();
-  for (const auto& x : spec.exports)
-    if (auto watched = subsystem.watch_writes(x.variable, bridge_options.exports_written); !watched)
-      spdlog::warn("dds: export {}: {}; it is polled", x.variable, watched.error().message);
-  return RemotePorts::create(spec, spec.name + shm_suffix, std::move(bridge_options));
 }
 
 }  // namespace
@@ -232,9 +218,9 @@ int run_command(const RunArgs& args) {
   }
 
   // The resource ports to other subsystems: on their own ordinary threads, attached to the table.
-  std::unique_ptr<RemotePorts> remote;
+  std::unique_ptr<DdsBridge> remote;
   if (spec->has_remote_variables()) {
-    auto bridge = start_bridge(*spec, subsystem, options.shm_suffix);
+    auto bridge = DdsBridge::start(*spec, subsystem, spec->name + options.shm_suffix);
     if (!bridge) {
       fmt::print(stderr, "{}: dds: {}\n", spec->file, bridge.error().message);
       subsystem.stop();
@@ -262,8 +248,8 @@ int run_command(const RunArgs& args) {
   session.run();
   network.reset();  // the network API ends before the subsystem stops
   if (remote) {
-    for (const auto& line : remote->take_errors()) err("dds: " + line + "\n");
-    remote.reset();  // the bridge stops writing imports before the tasks stop
+    for (const auto& line : remote->stop()) err("dds: " + line + "\n");  // it writes no import after this
+    remote.reset();                                                      // before the tasks stop
   }
 
   std::optional<std::string> exit_dump_failure;

@@ -142,7 +142,12 @@ Result<void> Subsystem::Impl::build_runtime(const std::string& configuration, st
     if (const auto v = m.table->find(variable)) m.executive->watch_writes(*v, watch.get());
   m.reconfiguration = std::make_unique<Reconfiguration>(resolved, configuration, *m.requests, *m.tasks, *m.executive,
                                                         *m.table, *m.events);
+  m.runtimes_built.fetch_add(1, std::memory_order_release);  // release: the new table is there before the count says so
   return {};
+}
+
+std::uint64_t Subsystem::runtimes_built() const {
+  return impl_->runtimes_built.load(std::memory_order_acquire);  // acquire: pairs with build_runtime()'s release
 }
 
 Subsystem::Subsystem() : impl_(std::make_unique<Impl>()) {}

@@ -130,6 +130,10 @@ class Subsystem {
   /// module processes wake nobody. Refuses a variable the table does not hold. Call it from the
   /// thread that drives the commands. Not real-time safe.
   Result<void> watch_writes(const std::string& variable, std::shared_ptr<WriteWatch> watch);
+  /// How many times the runtime (and with it the table, a new region under the same name) has
+  /// been made: 1 after create, one more for each task the live assembly added. Whoever attached
+  /// to the table by its name (the DDS bridge) attaches again when it changes. Any thread.
+  [[nodiscard]] std::uint64_t runtimes_built() const;
 
   // The live assembly (docs/control-api.md, "Live assembly"), what ros2_control users do with
   // load, configure and switch. Each refuses, changing nothing, what it cannot carry out, with one

@@ -111,18 +111,19 @@ struct Side {
 
   [[nodiscard]] std::string err() const { return process->err(); }
 
-  // The reply to `command`: `get theta_m` goes behind it, and its reply ends the first one's.
-  std::string ask(const std::string& command) const {
+  // The reply to `command`: `get VARIABLE` goes behind it, and its reply ends the first one's.
+  std::string ask(const std::string& command, const std::string& variable = "theta_m") const {
     const std::size_t before = process->out().size();
-    process->send(command + "\nget theta_m\n");
+    process->send(command + "\nget " + variable + "\n");
     std::string reply;
     eventually([&] {
       const std::string out = process->out();
       reply = out.size() > before ? out.substr(before) : std::string();
-      return reply.find("theta_m = [") != std::string::npos && reply.ends_with("]\n");
+      return reply.find(variable + " = [") != std::string::npos && reply.ends_with("]\n");
     });
     return reply;
   }
+  std::string get(const std::string& variable) const { return ask("# " + variable, variable); }
   std::string theta_m() const { return ask("# theta_m"); }
   bool flag_raised() const { return ask("status").find(kFlag) != std::string::npos; }
 
@@ -267,6 +268,44 @@ void robot_holds_while_vision_is_away(const std::vector<std::string>& vision_lau
   EXPECT_EQ(robot.process->wait_exit(), 0) << robot.err();
   EXPECT_EQ(robot.err().find("refused"), std::string::npos) << robot.err();
   EXPECT_EQ(robot.err().find("rule 1"), std::string::npos) << robot.err();
+}
+
+// The live assembly's add makes the vision side's table anew (a new region under the same name):
+// its bridge follows it there, so that x_d from the new table reaches the robot side and x_m from
+// the robot side reaches the new table. Before it did, the bridge stayed on the old region: the
+// robot side's import stayed stale and the vision task read x_m that never came.
+TEST(TwoSubsystems, TheBridgeFollowsTheTableThatAnAddMadeAnew) {
+  const Names names;
+  const std::string fresh = "dds: import x_d: fresh again, from subsystem " + names.vision + "\n";
+  Side robot(names.robot, robot_file(names), {});
+  Side vision(names.vision, vision_file(names), {});
+  ASSERT_TRUE(eventually([&] {
+    return robot.err().find("dds: import x_d: first sample, from subsystem " + names.vision + "\n") !=
+           std::string::npos;
+  })) << robot.err();
+  const std::string x_m_before = vision.get("x_m");
+  ASSERT_NE(Side::values(x_m_before), std::vector<double>(6, 0.0)) << "x_m came before the add";
+
+  // The vision task gone: the robot side's import goes stale; back after the add, fresh again.
+  const std::size_t fresh_before = count(robot.err(), fresh);
+  vision.process->send("kill vision\n");
+  ASSERT_TRUE(eventually([&] { return robot.err().find("dds: import x_d: stale") != std::string::npos; }))
+      << robot.err();
+  vision.process->send("add {name: spare, module: cpu_load, period: 100ms, criticality: soft}\n");
+  EXPECT_TRUE(eventually([&] { return vision.err().find("the bridge follows it") != std::string::npos; }, 10))
+      << vision.err() << vision.process->out();
+  // The new table's x_m is unwritten until the bridge writes it there: it does, from the robot.
+  EXPECT_TRUE(eventually([&] { return Side::values(vision.get("x_m")) != std::vector<double>(6, 0.0); }))
+      << vision.get("x_m");
+  vision.process->send("spawn vision\non vision\n");
+  ASSERT_TRUE(eventually([&] { return count(robot.err(), fresh) > fresh_before; })) << robot.err() << vision.err();
+  const std::string x_d = robot.get("x_d");
+  EXPECT_TRUE(eventually([&] { return robot.get("x_d") != x_d; })) << "x_d from the new table moves";
+
+  vision.process->send("quit\n");
+  EXPECT_EQ(vision.process->wait_exit(), 0) << vision.err();
+  robot.process->send("quit\n");
+  EXPECT_EQ(robot.process->wait_exit(), 0) << robot.err();
 }
 
 TEST(TwoSubsystems, TheRobotSideHoldsWhileTheVisionSideIsAwayOnOneNetworkStack) {
