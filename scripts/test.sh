@@ -158,9 +158,11 @@ for stage in "${stages[@]}"; do
   [[ -n "${failed_tests[${stage}]:-}" ]] || continue
   echo "  failed in ${stage}:"
   sed 's/^/    /' <<<"${failed_tests[${stage}]}"
-  # And what they said: GoogleTest's "FILE:LINE: Failure" lines with the few after each, so that
-  # a failure seen once in CI can be read without the middle of the log.
+  # And what they said: GoogleTest's "FILE:LINE: Failure" lines with the few after each, and
+  # node --test's "✖ TEST" with its error (the browser tests), so that a failure seen once
+  # in CI can be read without the middle of the log.
   grep -E -A4 ': Failure$' "${BUILD_DIRS[${stage}]}/chimera-ctest.log" 2>/dev/null | head -n 40 | sed 's/^/      | /'
+  grep -A8 '^✖ [^f]' "${BUILD_DIRS[${stage}]}/chimera-ctest.log" 2>/dev/null | awk '!seen[$0]++' | head -n 40 | sed 's/^/      | /'
 done
 # The closing line counts the tests of all trees; a tree that did not build counts as one failure.
 echo "chimera: ${total_passed} passed, ${total_failed} failed"

@@ -150,7 +150,9 @@ test('assembles Figure 4 from an empty canvas, runs it, plots it and saves a fil
     // The switch and the states it changed come as events, in the shell's words.
     await page.waitForSelector('#events li[data-type="switch"]', { timeout: 15000 });
     assert.match(await page.textContent('#events li[data-type="switch"]'), /switch empty → assembly \(operator\): on [a-z ]*pid/);
-    assert.match(await page.textContent('#events li[data-type="state"][data-task="pid"]'), /pid: NOT-CREATED → ON/);
+    // A change is what one look saw against the one before (docs/control-api.md, "Streams").
+    await page.waitForSelector('#events li[data-type="state"][data-task="pid"]:has-text("→ ON")', { timeout: 15000 });
+    assert.match(await page.textContent('#events li[data-type="state"][data-task="pid"]:has-text("→ ON")'), /pid: NOT-CREATED → ON/);
 
     // The timing of a task, live: the histogram is there and the cycles go on rising.
     await page.click('#tasks tr[data-task="pid"] button[data-action="stats"]');
@@ -202,7 +204,9 @@ test('a task in ERROR shows its message and the clear button brings it back', as
     assert.ok(message.length > 0, 'the ERROR has its message');
     // The ERROR came as events too: the state change, and the line that says why.
     await page.waitForSelector('#events li[data-type="log"][data-task="load"]', { timeout: 15000 });
-    assert.match(await page.textContent('#events li[data-type="state"][data-task="load"]'), /load: ON → ERROR/);
+    // The look after the switch may come after the first miss: then it saw NOT-CREATED → ERROR.
+    await page.waitForSelector('#events li[data-type="state"][data-task="load"]:has-text("→ ERROR")', { timeout: 15000 });
+    assert.match(await page.textContent('#events li[data-type="state"][data-task="load"]:has-text("→ ERROR")'), /load: (ON|NOT-CREATED) → ERROR/);
     assert.ok(await page.$('#canvas g.task.state-ERROR[data-task="load"]'), 'the canvas shows ERROR by colour');
     await page.screenshot({ path: join(shots, 'onika-error.png') });
     await page.click('#tasks tr[data-task="load"] button[data-action="clear"]');
