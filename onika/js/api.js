@@ -61,6 +61,9 @@ export const api = {
   model: async () => (await request('GET', '/api/subsystem')).subsystem,
   modules: async () => (await request('GET', '/api/modules')).modules,
   whoami: async () => (await request('GET', '/api/whoami')).role,
+  examples: async () => (await request('GET', '/api/examples')).examples,
+  /** Replaces the running subsystem with a file's: {file: name, text}. */
+  open: (file, text) => request('POST', '/api/open', { file, text }),
 };
 
 /**

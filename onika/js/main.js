@@ -8,6 +8,7 @@ import { Canvas } from './canvas.js';
 import { el, clear, durationText } from './dom.js';
 import { EventList } from './events.js';
 import { Library, modulePage } from './library.js';
+import { OpenDialog } from './open.js';
 import { Plot, parseLog } from './plots.js';
 import { TaskTable, timingPage } from './tasks.js';
 
@@ -393,6 +394,21 @@ $('save').addEventListener('click', async () => {
 });
 $('save-close').addEventListener('click', () => $('save-dialog').close());
 
+const opener = new OpenDialog($('open-dialog'), {
+  onOpened: async (reply) => {
+    // Another subsystem: nothing drawn for the one before is kept.
+    page.drafts = [];
+    page.editing = reply.configuration;
+    page.compare = '';
+    stream.close();
+    plot.reset(false);
+    if (page.timingTask) watchTiming('');
+    say(`open ${reply.file}: ${reply.text.trim()}`);
+    await refresh(true);
+  },
+});
+$('open').addEventListener('click', () => opener.show());
+
 const library = new Library($('library'), {
   onShow: (m) => {
     if (page.timingTask) watchTiming('');
@@ -413,6 +429,7 @@ async function start() {
   $('login').hidden = true;
   $('app').hidden = false;
   $('save').hidden = false;
+  $('open').hidden = page.role !== 'operator';
   document.body.dataset.role = page.role;
   library.set(await api.modules());
   await refresh(true);

@@ -1,4 +1,4 @@
-// The live assembly's verbs of the command API: add, define, verify, remove and save, each one
+// The live assembly's verbs of the command API: add, define, verify, remove, save and open, each one
 // call of the Subsystem's live assembly and the words the shell prints for it.
 
 #include <unistd.h>
@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "chimera/config/loader.hpp"
 #include "chimera/control/control.hpp"
 #include "reply_text.hpp"
 
@@ -25,6 +26,7 @@ using control_detail::said;
 std::string verdict(const std::vector<Violation>& violations) {
   if (violations.empty()) return "legal";
   std::vector<std::string> reasons;
+  reasons.reserve(violations.size());
   for (const auto& v : violations) reasons.push_back(violation_reason(v));
   return fmt::format("not legal: {}", fmt::join(reasons, "; "));
 }
@@ -73,6 +75,7 @@ Reply Control::assemble(const Command& command) {
     case Verb::kVerify: return verify(command.args.at(0));
     case Verb::kRemove: return remove(command.args.at(0));
     case Verb::kSave: return save(command.args);
+    case Verb::kOpen: return open(command.args.at(0));
     default: return refused(fmt::format("{}: not a live assembly command", verb_name(command.verb)));
   }
 }
@@ -111,6 +114,18 @@ Reply Control::save(const std::vector<std::string>& args) const {
   if (args.empty()) return said(*std::move(text));
   if (auto written = write_whole(args.front(), *text); !written) return refused(written.error().message);
   return said(fmt::format("saved to {}\n", args.front()));
+}
+
+Reply Control::open(const std::string& file) {
+  // The modules the subsystem has: a file's plugins: are loaded by chimera run FILE, not here.
+  auto spec = load_subsystem_file(file, subsystem_.registry());
+  if (!spec) return refused(spec.error().message);
+  if (auto replaced = subsystem_.replace(*std::move(spec)); !replaced) return refused(replaced.error().message);
+  std::vector<std::string> states;
+  for (const auto& [task, state] : subsystem_.states())
+    states.push_back(fmt::format("{}: {}", task, state_name(state)));
+  return said(fmt::format("opened {}: subsystem {}, configuration '{}' on ({})\n", file, subsystem_.spec().name,
+                          subsystem_.configuration(), fmt::join(states, ", ")));
 }
 
 }  // namespace chimera

@@ -51,6 +51,8 @@ constexpr std::array kVerbs{
     VerbSpec{Verb::kRemove, "remove", 1, 1, "remove TASK", "remove a task that no configuration uses"},
     VerbSpec{Verb::kSave, "save", 0, 1, "save [FILE]",
              "the subsystem as a file that chimera verify accepts (to FILE, or as the reply)"},
+    VerbSpec{Verb::kOpen, "open", 1, 1, "open FILE",
+             "run another subsystem file instead (every task off and killed; its start configuration on)"},
     VerbSpec{Verb::kDump, "dump", 0, 1, "dump [DIR]",
              "write the flight recorder's last seconds of every variable and task's timing (to DIR, or a new one)"},
 };

@@ -97,7 +97,8 @@ Reply Control::execute(const Command& command) {
       case Verb::kDefine:
       case Verb::kVerify:
       case Verb::kRemove:
-      case Verb::kSave: return assemble(command);
+      case Verb::kSave:
+      case Verb::kOpen: return assemble(command);
       case Verb::kDump: {
         auto written = subsystem_.dump(command.args.empty() ? std::string() : command.args[0], "the operator's dump");
         if (!written) return refused(written.error().message);

@@ -43,8 +43,10 @@ std::string entry_message(std::string_view message) {
     if (const auto colon = message.find(": "); colon != std::string_view::npos) message.remove_prefix(colon + 2);
   }
   if (message.starts_with("tasks[")) {
-    if (const auto dot = message.find("]."); dot != std::string_view::npos) message.remove_prefix(dot + 2);
-    else if (const auto colon = message.find("]: "); colon != std::string_view::npos) message.remove_prefix(colon + 3);
+    if (const auto dot = message.find("]."); dot != std::string_view::npos)
+      message.remove_prefix(dot + 2);
+    else if (const auto colon = message.find("]: "); colon != std::string_view::npos)
+      message.remove_prefix(colon + 3);
   }
   return std::string(message);
 }
@@ -80,6 +82,43 @@ SubsystemSpec Subsystem::Impl::live_spec() const {
   return out;
 }
 
+Result<void> Subsystem::Impl::rebuild_runtime(SubsystemSpec next, const std::string& configuration,
+                                              const SubsystemSpec& current, const std::string& current_configuration) {
+  Impl& m = *this;
+  std::unique_lock<std::shared_mutex> runtime(m.runtime_mutex);
+  // What the runtime that ends leaves for the run to report: its events, faults, a hard failure.
+  m.events->collect(*m.tasks);
+  const std::vector<Event> drained = m.events->drain();
+  {
+    std::lock_guard<std::mutex> notes(m.notes_mutex);
+    m.earlier_events.insert(m.earlier_events.end(), drained.begin(), drained.end());
+  }
+  for (auto& line : m.runtime_faults()) m.earlier_faults.push_back(std::move(line));
+  m.earlier_hard_failure = m.earlier_hard_failure || m.tasks->hard_task_failed();
+  std::vector<SwitchRecord> history = m.reconfiguration->history();
+  const std::int64_t now = m.executive->now_ns();
+  m.executive->shutdown();
+  m.reconfiguration.reset();
+  m.executive.reset();
+  m.events.reset();
+  m.tasks.reset();
+  m.block.reset();
+  m.requests.reset();
+  m.table.reset();  // the region's name is free again for the new table
+  m.spec = std::move(next);
+  Result<void> outcome = m.build_runtime(configuration, now);
+  if (!outcome) {
+    // Only the environment can refuse here (a full /dev/shm, the subsystem's name taken by
+    // another process, a worker that cannot start): put back what ran.
+    m.spec = current;
+    const auto restored = m.build_runtime(current_configuration, now);
+    CHIMERA_INVARIANT(restored.ok(), "the subsystem could not be made again as it was");
+  }
+  // One history of switches for the run, however often its runtime is made: the streams count it.
+  m.reconfiguration->carry_history(std::move(history));
+  return outcome;
+}
+
 Result<std::string> Subsystem::add_task(std::string_view entry) {
   Impl& m = *impl_;
   while (!entry.empty() && entry.front() == ' ') entry.remove_prefix(1);
@@ -97,8 +136,9 @@ Result<std::string> Subsystem::add_task(std::string_view entry) {
     // A module process reads its tasks from the file: a task the file does not have would shift
     // every index it shares with the main process (docs/processes.md).
     if (m.block)
-      return make_error(Errc::kState, "add: not in a subsystem with module processes (process:): their workers "
-                                      "run the tasks of the file as it was started");
+      return make_error(Errc::kState,
+                        "add: not in a subsystem with module processes (process:): their workers "
+                        "run the tasks of the file as it was started");
     current = m.live_spec();
   }
   auto next = with_task(current, entry, *m.registry);
@@ -136,35 +176,8 @@ Result<std::string> Subsystem::add_task(std::string_view entry) {
                                        "executive is made anew for it)",
                                        created->name(), state_name(created->state())));
     } else {
-      std::unique_lock<std::shared_mutex> runtime(m.runtime_mutex);
-      m.events->collect(*m.tasks);
-      const std::vector<Event> drained = m.events->drain();
-      {
-        std::lock_guard<std::mutex> notes(m.notes_mutex);
-        m.earlier_events.insert(m.earlier_events.end(), drained.begin(), drained.end());
-      }
-      for (auto& line : m.runtime_faults()) m.earlier_faults.push_back(std::move(line));
-      m.earlier_hard_failure = m.earlier_hard_failure || m.tasks->hard_task_failed();
-      std::vector<SwitchRecord> history = m.reconfiguration->history();
       const std::string configuration = m.reconfiguration->configuration();
-      const std::int64_t now = m.executive->now_ns();
-      m.executive->shutdown();
-      m.reconfiguration.reset();
-      m.executive.reset();
-      m.events.reset();
-      m.tasks.reset();
-      m.block.reset();
-      m.requests.reset();
-      m.table.reset();  // the region's name is free again for the new table
-      m.spec = *std::move(next);
-      outcome = m.build_runtime(configuration, now);
-      if (!outcome) {
-        // Only the environment can refuse here (a full /dev/shm): put back what ran.
-        m.spec = current;
-        const auto restored = m.build_runtime(configuration, now);
-        CHIMERA_INVARIANT(restored.ok(), "add: the subsystem could not be made again as it was");
-      }
-      m.reconfiguration->carry_history(std::move(history));
+      outcome = m.rebuild_runtime(*std::move(next), configuration, current, configuration);
     }
   }
   if (serve_again) serve_requests();
@@ -260,8 +273,8 @@ Result<std::string> Subsystem::save_yaml() const {
   std::string text = write_subsystem_yaml(spec);
   // The file must read back as this subsystem; if not, that is the writer's fault, not the user's.
   if (auto back = load_subsystem_text(text, spec.file, *m.registry); !back)
-    return make_error(Errc::kInvalidInput, fmt::format("save: internal error, the file does not read back: {}",
-                                                       back.error().message));
+    return make_error(Errc::kInvalidInput,
+                      fmt::format("save: internal error, the file does not read back: {}", back.error().message));
   return text;
 }
 

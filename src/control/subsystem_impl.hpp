@@ -14,10 +14,10 @@
 #include "chimera/control/subsystem.hpp"
 #include "chimera/svt/global_table.hpp"
 #include "exec/event_log.hpp"
-#include "flight_recorder.hpp"
 #include "exec/executive.hpp"
 #include "exec/task_block.hpp"
 #include "exec/task_set.hpp"
+#include "flight_recorder.hpp"
 #include "reconfig/reconfiguration.hpp"
 #include "reconfig/request_board.hpp"
 
@@ -35,7 +35,7 @@ struct Subsystem::Impl {
   std::unique_ptr<SubsystemRequestBoard> requests;
   std::unique_ptr<TaskBlock> block;  // module processes' tasks' shared slots (docs/processes.md); null: none
   std::unique_ptr<TaskSet> tasks;
-  std::unique_ptr<FlightRecorder> recorder;  // the tasks write into it; null: none kept
+  std::unique_ptr<FlightRecorder> recorder;   // the tasks write into it; null: none kept
   std::vector<std::uint64_t> dumped_failure;  // per task, the failure its ERROR dump was for; run_for's thread only
   std::unique_ptr<EventLog> events;
   std::unique_ptr<Executive> executive;
@@ -66,9 +66,9 @@ struct Subsystem::Impl {
   std::vector<std::string> kill_faults;
   std::vector<bool> removed;
   // What earlier runtimes (before an add rebuilt it) left that the run still reports.
-  std::vector<Event> earlier_events;         // not drained yet
-  std::vector<std::string> earlier_faults;   // faults() lines
-  std::vector<std::string> left_behind;      // tasks whose thread stop() left behind, stuck in a method
+  std::vector<Event> earlier_events;        // not drained yet
+  std::vector<std::string> earlier_faults;  // faults() lines
+  std::vector<std::string> left_behind;     // tasks whose thread stop() left behind, stuck in a method
   // watch_writes(): each variable's watch, applied to every executive build_runtime() makes.
   std::vector<std::pair<std::string, std::shared_ptr<WriteWatch>>> watches;
   bool earlier_hard_failure = false;
@@ -105,6 +105,12 @@ struct Subsystem::Impl {
   /// clock starting at `start_ns`. Refuses an illegal `configuration` before it creates anything.
   /// Callers hold ops_mutex and runtime_mutex (or own the subsystem alone). Not real-time safe.
   Result<void> build_runtime(const std::string& configuration, std::int64_t start_ns);
+  /// The live assembly's rebuild, while no task is created: the runtime ends (what it leaves to
+  /// report is kept) and is made anew for `next` with `configuration` on, the clock going on.
+  /// Should the machine refuse it, `current` is made again with `current_configuration`, and the
+  /// refusal returned. Callers hold ops_mutex (not runtime_mutex: it is taken here).
+  Result<void> rebuild_runtime(SubsystemSpec next, const std::string& configuration, const SubsystemSpec& current,
+                               const std::string& current_configuration);
 };
 
 /// Refuses a task pinned to a CPU this machine does not have.

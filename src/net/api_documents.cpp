@@ -11,6 +11,7 @@
 #include "chimera/module/param_rule.hpp"
 #include "chimera/svt/elem_type.hpp"
 #include "chimera/svt/port_kind.hpp"
+#include "example_files.hpp"
 
 namespace chimera::net {
 
@@ -108,6 +109,12 @@ json subsystem_model_json(const Subsystem& subsystem) {
               {"illegal_configuration", subsystem.illegal_configuration()},
               {"tasks", std::move(tasks)},
               {"configurations", std::move(configurations)}};
+}
+
+json examples_json() {
+  json list = json::array();
+  for (const auto& e : example_files()) list.push_back(json{{"name", e.name}, {"title", e.title}, {"text", e.text}});
+  return list;
 }
 
 }  // namespace chimera::net

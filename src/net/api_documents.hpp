@@ -23,6 +23,9 @@ nlohmann::json module_library_json(const Registry& registry);
 /// paper's equations 1 and 2 and of the size rule), the one on now. Call it under the gate.
 nlohmann::json subsystem_model_json(const Subsystem& subsystem);
 
+/// The example subsystem files the program was built with (examples/): name, title and text.
+nlohmann::json examples_json();
+
 /// Violations as the replies of define and verify give them: rule, variable, tasks, reason.
 nlohmann::json violations_json(const std::vector<Violation>& violations);
 

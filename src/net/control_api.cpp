@@ -1,6 +1,7 @@
 #include "chimera/net/control_api.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <charconv>
 #include <optional>
@@ -166,6 +167,29 @@ void assembly_json(const Command& c, const Subsystem& subsystem, json& more) {
   }
 }
 
+// `body` parsed into `doc`; or the 400 reply. A syntax error (parse_error) or a number too large
+// for a double (out_of_range.406, thrown by the same parse): "[json.exception.parse_error.101]
+// parse error at line 1, ...", of which the part after the tag is said.
+std::optional<ApiResponse> parse_body(std::string_view body, json& doc) {
+  try {
+    doc = json::parse(body);
+  } catch (const json::exception& e) {
+    std::string_view what = e.what();
+    if (const auto tag_end = what.find("] "); tag_end != std::string_view::npos) what.remove_prefix(tag_end + 2);
+    return ControlApi::error(400, "bad_json", fmt::format("the body is not JSON: {}", what));
+  }
+  return std::nullopt;
+}
+
+// The paths of GET's documents (ControlApi::document), and the variables' below kVariables.
+constexpr std::string_view kVariables = "/api/variables/";
+constexpr std::array<std::string_view, 6> kDocuments{"/api/status",   "/api/whoami",  "/api/examples",
+                                                     "/api/commands", "/api/modules", "/api/subsystem"};
+bool is_document(std::string_view path) {
+  return path.substr(0, kVariables.size()) == kVariables ||
+         std::find(kDocuments.begin(), kDocuments.end(), path) != kDocuments.end();
+}
+
 }  // namespace
 
 bool verb_needs_operator(Verb verb) {
@@ -217,21 +241,24 @@ ApiResponse ControlApi::handle(const ApiRequest& request) {
     return r;
   };
   const std::string_view path = request.path;
-  if (path == "/api/command") {
+  if (path == "/api/command" || path == "/api/open") {
     if (auto refused = only("POST")) return *refused;
     if (request.body.size() > kMaxBodyBytes) return too_large();  // a transport that did not check
-    return command(*role, request.body);
+    return path == "/api/command" ? command(*role, request.body) : open(*role, request.body);
   }
-  if (path == "/api/status") {
+  if (is_document(path)) {
     if (auto refused = only("GET")) return *refused;
-    return status();
+    return document(*role, path);
   }
-  if (path == "/api/whoami") {
-    if (auto refused = only("GET")) return *refused;
-    return reply(json{{"role", role_name(*role)}});
-  }
+  return error(404, "not_found", fmt::format("no such endpoint: {} (see docs/control-api.md)", path));
+}
+
+ApiResponse ControlApi::document(Role role, std::string_view path) {
+  if (path.substr(0, kVariables.size()) == kVariables) return variable(path.substr(kVariables.size()));
+  if (path == "/api/status") return status();
+  if (path == "/api/whoami") return reply(json{{"role", role_name(role)}});
+  if (path == "/api/examples") return reply(json{{"examples", examples_json()}});
   if (path == "/api/commands") {
-    if (auto refused = only("GET")) return *refused;
     json verbs = json::array();
     for (const auto& h : verb_help())
       verbs.push_back(json{{"verb", verb_name(h.verb)},
@@ -241,37 +268,21 @@ ApiResponse ControlApi::handle(const ApiRequest& request) {
     return reply(json{{"commands", std::move(verbs)}});
   }
   if (path == "/api/modules") {
-    if (auto refused = only("GET")) return *refused;
     json modules = gate_.exclusive(
         [](Control& /*control*/, Subsystem& subsystem) { return module_library_json(subsystem.registry()); });
     return reply(json{{"modules", std::move(modules)}});
   }
   if (path == "/api/subsystem") {
-    if (auto refused = only("GET")) return *refused;
     json model =
         gate_.exclusive([](Control& /*control*/, Subsystem& subsystem) { return subsystem_model_json(subsystem); });
     return reply(json{{"subsystem", std::move(model)}});
-  }
-  constexpr std::string_view kVariables = "/api/variables/";
-  if (path.substr(0, kVariables.size()) == kVariables) {
-    if (auto refused = only("GET")) return *refused;
-    return variable(path.substr(kVariables.size()));
   }
   return error(404, "not_found", fmt::format("no such endpoint: {} (see docs/control-api.md)", path));
 }
 
 ApiResponse ControlApi::command(Role role, std::string_view body) {
   json doc;
-  try {
-    doc = json::parse(body);
-  } catch (const json::exception& e) {
-    // A syntax error (parse_error) or a number too large for a double (out_of_range.406, thrown
-    // by the same parse): "[json.exception.parse_error.101] parse error at line 1, ...", of which
-    // the part after the tag is said.
-    std::string_view what = e.what();
-    if (const auto tag_end = what.find("] "); tag_end != std::string_view::npos) what.remove_prefix(tag_end + 2);
-    return error(400, "bad_json", fmt::format("the body is not JSON: {}", what));
-  }
+  if (auto bad = parse_body(body, doc)) return *bad;
   auto line = command_line(doc);
   if (line.index() == 1) return error(400, "bad_request", std::get<1>(line));
   const std::string& text = std::get<0>(line);
@@ -283,6 +294,9 @@ ApiResponse ControlApi::command(Role role, std::string_view body) {
   if (verb_needs_operator(c.verb) && role != Role::kOperator)
     return error(403, "forbidden", fmt::format("{}: needs an operator's token; this one is a viewer's", verb));
   if (c.verb == Verb::kWait) return wait(c);
+  if (c.verb == Verb::kOpen)
+    return error(400, "bad_command",
+                 "open FILE reads the server's machine: over the network POST /api/open with the file's text");
   if (c.verb == Verb::kSave && !c.args.empty())
     return error(400, "bad_command",
                  "save FILE writes on the server's machine: over the network send save alone; the reply's yaml is the "
@@ -319,6 +333,51 @@ ApiResponse ControlApi::command(Role role, std::string_view body) {
   ApiResponse done = reply(std::move(extra));
   done.stops_subsystem = r.quit;
   return done;
+}
+
+ApiResponse ControlApi::open(Role role, std::string_view body) {
+  if (role != Role::kOperator)
+    return error(403, "forbidden", "open: needs an operator's token; this one is a viewer's");
+  json doc;
+  if (auto bad = parse_body(body, doc)) return *bad;
+  constexpr std::string_view kShape = R"(the body is {"file": "fig4.yaml", "text": "the file's text"})";
+  if (!doc.is_object() || !doc.contains("file") || !doc.contains("text") || !doc["file"].is_string() ||
+      !doc["text"].is_string())
+    return error(400, "bad_request", kShape);
+  for (const auto& [key, value] : doc.items())
+    if (key != "file" && key != "text")
+      return error(400, "bad_request", fmt::format("unknown key '{}': {}", key, kShape));
+  const std::string& name = doc["file"].get_ref<const std::string&>();
+
+  std::optional<ApiResponse> refusal;
+  auto [r, extra] = gate_.exclusive([&](Control& control, Subsystem& subsystem) {
+    json more = json::object();
+    auto path = opened_.write(name, doc["text"].get_ref<const std::string&>());
+    if (!path) {
+      refusal = error(path.error().code == Errc::kInvalidInput ? 400 : 500,
+                      path.error().code == Errc::kInvalidInput ? "bad_request" : "system", path.error().message);
+      return std::pair{Reply{}, std::move(more)};
+    }
+    Command c;
+    c.verb = Verb::kOpen;
+    c.args.push_back(*path);
+    Reply done = control.execute(c);
+    if (done.ok) {
+      more["status"] = status_json(subsystem);
+      more["configuration"] = subsystem.configuration();
+    }
+    return std::pair{std::move(done), std::move(more)};
+  });
+  if (refusal) return *refusal;
+  extra["verb"] = "open";
+  extra["file"] = name;
+  extra["text"] = opened_.as_named(r.text);
+  if (!r.ok) {
+    extra["ok"] = false;
+    extra["error"] = json{{"code", "refused"}, {"message", opened_.as_named(last_line(r.text))}};
+    return ApiResponse{409, dump(extra), {}};
+  }
+  return reply(std::move(extra));
 }
 
 ApiResponse ControlApi::status() {

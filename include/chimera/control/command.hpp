@@ -32,6 +32,7 @@ enum class Verb {
   kVerify,
   kRemove,
   kSave,
+  kOpen,
   // The flight recorder (docs/flight-recorder.md).
   kDump,
 };

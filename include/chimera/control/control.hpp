@@ -48,6 +48,7 @@ class Control {
   Reply verify(const std::string& configuration) const;
   Reply remove(const std::string& task);
   Reply save(const std::vector<std::string>& args) const;
+  Reply open(const std::string& file);
 
   Subsystem& subsystem_;
 };

@@ -159,6 +159,12 @@ class Subsystem {
   /// verify` accepts and `chimera run` starts as this subsystem. Refused while a configuration is
   /// illegal or there is no task (a file has at least one).
   [[nodiscard]] Result<std::string> save_yaml() const;
+  /// Replaces the subsystem with another file's (`next`, as the loader read it), keeping the run,
+  /// its clock and options: every task is turned off and killed, the runtime is made anew for
+  /// `next` and its `start` configuration turned on, as chimera run starts a file. Refused,
+  /// changing nothing, when `next` is not legal (its start configuration), pins a CPU this machine
+  /// lacks, or either subsystem has DDS exports or imports (the bridge is made for the first).
+  Result<void> replace(SubsystemSpec next);
   /// The names of the configurations, in definition order. Any thread.
   [[nodiscard]] std::vector<std::string> configurations() const;
 

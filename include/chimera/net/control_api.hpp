@@ -13,6 +13,7 @@
 #include "chimera/control/command.hpp"
 #include "chimera/net/access_tokens.hpp"
 #include "chimera/net/control_gate.hpp"
+#include "chimera/net/opened_files.hpp"
 
 namespace chimera::net {
 
@@ -79,11 +80,15 @@ class ControlApi {
   ApiResponse status();
   ApiResponse variable(std::string_view name);
   ApiResponse wait(const Command& command);
+  ApiResponse open(Role role, std::string_view body);
+  // The reply of a GET endpoint (is_document() in control_api.cpp says which paths are).
+  ApiResponse document(Role role, std::string_view path);
 
   ControlGate& gate_;
   AccessTokens tokens_;
   std::function<void()> on_quit_;
   std::atomic<bool> closing_{false};  // seq_cst: set once at close, read by waits; rare, simplest
+  OpenedFiles opened_;                // the files POST /api/open wrote; used under the gate
 };
 
 }  // namespace chimera::net

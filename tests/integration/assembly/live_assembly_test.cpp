@@ -49,6 +49,7 @@ class LiveAssemblyTest : public ::testing::Test {
     RunOptions options;
     options.clock = ClockKind::kVirtual;
     options.shm_suffix = unique_suffix();
+    suffix_ = options.shm_suffix;
     auto created = Subsystem::create(spec, Registry::global(), options);
     ASSERT_TRUE(created.ok()) << created.error().message;
     subsystem_ = std::move(*created);
@@ -98,6 +99,7 @@ class LiveAssemblyTest : public ::testing::Test {
 
   std::unique_ptr<Subsystem> subsystem_;
   std::unique_ptr<Control> control_;
+  std::string suffix_;  // of the subsystem's shared memory
 };
 
 TEST_F(LiveAssemblyTest, VerifyNamesTheSetDifferenceAndNeverSwitches) {
@@ -106,7 +108,8 @@ TEST_F(LiveAssemblyTest, VerifyNamesTheSetDifferenceAndNeverSwitches) {
   const Reply defined = ok("define open_loop traj robot");
   EXPECT_TRUE(contains(defined.text, "not legal: tau_r has no producer (read by robot)")) << defined.text;
   const Reply verified = ok("verify open_loop");
-  EXPECT_TRUE(contains(verified.text, "configuration 'open_loop' is not legal: tau_r has no producer")) << verified.text;
+  EXPECT_TRUE(contains(verified.text, "configuration 'open_loop' is not legal: tau_r has no producer"))
+      << verified.text;
   EXPECT_TRUE(contains(verified.text, "rule 2: tau_r")) << verified.text;
   EXPECT_EQ(subsystem_->configuration(), "pid_control");
   // Two producers of one variable (eq. 1): the robot interfaces both publish theta_m.
@@ -259,6 +262,106 @@ TEST_F(LiveAssemblyTest, SaveWritesAFileThatVerifiesAndStartsTheSameSubsystem) {
 
   ok("define open_loop traj robot");
   refused("save", "configuration 'open_loop' is not legal");
+}
+
+// Another subsystem for open: two tasks, and its start configuration runs both.
+constexpr const char* kOther = R"(subsystem: other_test
+tasks:
+  - {name: fast, module: cpu_load, period: 2ms, criticality: soft}
+  - {name: slow, module: cpu_load, period: 10ms, criticality: soft}
+configurations:
+  only_fast: [fast]
+  both: [fast, slow]
+start: both
+)";
+
+std::string written(const std::string& name, const std::string& text) {
+  const std::string path = ::testing::TempDir() + "/" + std::to_string(::getpid()) + "_" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST_F(LiveAssemblyTest, OpenRunsAnotherFileInTheRunningSubsystem) {
+  start_text(kFig4);
+  run_for(50 * kMs);
+  ok("define loaded traj pid robot load");
+  ok("switch loaded");
+  run_for(10 * kMs);
+  const std::string other = written("other.yaml", kOther);
+  const std::int64_t before = subsystem_->now_ns();
+  const Reply opened = ok("open " + other);
+  EXPECT_EQ(opened.text, "opened " + other + ": subsystem other_test, configuration 'both' on (fast: ON, slow: ON)\n");
+  // The file's tasks and nothing of Figure 4's; the run's clock and its history of switches go on.
+  EXPECT_EQ(states(), "fast:ON slow:ON ");
+  EXPECT_EQ(subsystem_->spec().name, "other_test");
+  EXPECT_EQ(subsystem_->configuration(), "both");
+  EXPECT_EQ(subsystem_->now_ns(), before);
+  EXPECT_EQ(subsystem_->switches().size(), 1U);
+  EXPECT_FALSE(subsystem_->get("theta_m").ok());
+  run_for(100 * kMs);
+  EXPECT_EQ(task("fast").stats.cycles, 50U);  // every 2 ms release of 100 ms, on time
+  EXPECT_EQ(task("slow").stats.cycles, 10U);
+  EXPECT_EQ(task("fast").stats.missed, 0U);
+  ok("switch only_fast");
+  EXPECT_EQ(task("slow").state, TaskState::kOff);
+
+  // And back to Figure 4 from its file: the arm follows the trajectory again.
+  const Reply back = ok("open " + written("fig4.yaml", kFig4));
+  EXPECT_TRUE(contains(back.text,
+                       "subsystem assembly_test, configuration 'pid_control' on (traj: ON, pid: ON, robot: "
+                       "ON, load: NOT-CREATED, spare: NOT-CREATED)"))
+      << back.text;
+  run_for(300 * kMs);
+  EXPECT_EQ(task("robot").stats.cycles, 300U);
+  auto theta_m = subsystem_->get("theta_m");
+  auto theta_d = subsystem_->get("theta_d");
+  ASSERT_TRUE(theta_m.ok() && theta_d.ok());
+  for (std::size_t j = 0; j < theta_m->size(); ++j) EXPECT_NEAR((*theta_m)[j], (*theta_d)[j], 0.05) << j;
+  EXPECT_EQ(subsystem_->switches().size(), 2U);
+}
+
+TEST_F(LiveAssemblyTest, OpenRefusesAFileThatCannotRunAndChangesNothing) {
+  start_text(kFig4);
+  run_for(20 * kMs);
+  std::string bad_period(kOther);
+  bad_period.replace(bad_period.find("period: 10ms"), 12, "period: 10 ms");
+  const std::string path = written("bad_period.yaml", bad_period);
+  refused("open " + path, path + ":4: tasks[1].period");
+  refused("open " + written("illegal.yaml", std::string(kFig4).replace(std::string(kFig4).find("[traj, pid, robot]"),
+                                                                       18, "[traj, robot]")),
+          "configuration 'pid_control' is not legal: configuration 'pid_control': rule 2");
+  refused("open " + written("broken.yaml", "subsystem: x\ntasks: [\n"), "broken.yaml");
+  refused("open /nonexistent/chimera.yaml", "/nonexistent/chimera.yaml");
+  refused("open " + written("unknown.yaml",
+                            std::string(kOther).replace(std::string(kOther).find("cpu_load"), 8, "no_such_module")),
+          "no_such_module");
+  EXPECT_EQ(subsystem_->spec().name, "assembly_test");
+  run_for(20 * kMs);
+  EXPECT_EQ(task("robot").stats.cycles, 40U);  // every cycle of the 40 ms ran through the refusals
+}
+
+TEST_F(LiveAssemblyTest, AnOpenTheMachineRefusesPutsTheSubsystemBackRunning) {
+  start_text(kFig4);
+  run_for(20 * kMs);
+  // The file's subsystem already runs on this machine (its shared memory is taken): found only
+  // once the tasks were killed, so the subsystem before is made and started again.
+  auto spec = load_subsystem_text(kOther, "other.yaml", Registry::global());
+  ASSERT_TRUE(spec.ok());
+  RunOptions options;
+  options.clock = ClockKind::kVirtual;
+  options.shm_suffix = suffix_;
+  auto elsewhere = Subsystem::create(*spec, Registry::global(), options);
+  ASSERT_TRUE(elsewhere.ok()) << elsewhere.error().message;
+  const Reply r = run("open " + written("other.yaml", kOther));
+  EXPECT_FALSE(r.ok) << r.text;
+  EXPECT_TRUE(contains(r.text, "subsystem 'other_test" + suffix_ + "' is already running")) << r.text;
+  EXPECT_TRUE(contains(r.text, "the subsystem before runs again, configuration 'pid_control' started anew")) << r.text;
+  EXPECT_EQ(subsystem_->spec().name, "assembly_test");
+  EXPECT_EQ(states(), "traj:ON pid:ON robot:ON load:NOT-CREATED spare:NOT-CREATED ");
+  const std::uint64_t cycles = task("robot").stats.cycles;
+  run_for(50 * kMs);
+  EXPECT_EQ(task("robot").stats.cycles, cycles + 50);
+  (*elsewhere)->stop();
 }
 
 }  // namespace

@@ -177,7 +177,8 @@ TEST_F(ControlApiHttpTest, EveryShellCommandOverHttp) {
   EXPECT_EQ(roles["verify"], "viewer");  // checks, changes nothing
   EXPECT_EQ(roles["save"], "viewer");    // over the network save only replies with the file
   EXPECT_EQ(roles["dump"], "operator");  // writes files on the server's machine
-  EXPECT_EQ(roles.size(), 19U);
+  EXPECT_EQ(roles["open"], "operator");  // replaces the subsystem
+  EXPECT_EQ(roles.size(), 20U);
 
   // quit stops the subsystem cleanly: the process ends with the timing table.
   r = run("quit");

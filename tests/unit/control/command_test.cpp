@@ -118,8 +118,9 @@ TEST(ParseCommand, BlankAndCommentLines) {
 TEST(ParseCommand, HelpCoversEveryVerb) {
   std::vector<std::string_view> verbs;
   for (const auto& h : verb_help()) verbs.push_back(verb_name(h.verb));
-  EXPECT_EQ(verbs.size(), 19U);  // the 13 of the shell, live assembly's add, define, verify, remove, save, and dump
-  for (const char* assembly : {"add", "define", "verify", "remove", "save", "dump"})
+  EXPECT_EQ(verbs.size(),
+            20U);  // the 13 of the shell, live assembly's add, define, verify, remove, save, open, and dump
+  for (const char* assembly : {"add", "define", "verify", "remove", "save", "open", "dump"})
     EXPECT_NE(std::find(verbs.begin(), verbs.end(), assembly), verbs.end()) << assembly;
   for (const auto& h : verb_help()) EXPECT_FALSE(h.does.empty());
   EXPECT_NE(std::find(verbs.begin(), verbs.end(), "switch"), verbs.end());
