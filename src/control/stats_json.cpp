@@ -9,7 +9,8 @@
 
 namespace chimera {
 
-std::string stats_json(std::span<const TaskSnapshot> tasks, ClockKind clock, std::uint64_t switches, bool rt_check) {
+std::string stats_json(std::span<const TaskSnapshot> tasks, ClockKind clock, std::uint64_t switches, bool rt_check,
+                       JsonLayout layout) {
   // ordered_json keeps the tasks in file order, which is how people read them.
   using Json = nlohmann::ordered_json;
   Json per_task = Json::object();
@@ -52,7 +53,7 @@ std::string stats_json(std::span<const TaskSnapshot> tasks, ClockKind clock, std
       {"rt_check", rt_check},
       {"tasks", std::move(per_task)},
   };
-  return doc.dump(2) + "\n";
+  return layout == JsonLayout::kIndented ? doc.dump(2) + "\n" : doc.dump();
 }
 
 Result<void> write_stats_json(const std::string& path, std::span<const TaskSnapshot> tasks, ClockKind clock,

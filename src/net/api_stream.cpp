@@ -209,7 +209,7 @@ std::string ApiStream::timing(const std::vector<std::string>& tasks, std::uint64
                   [&](const TaskSnapshot& t) { return std::find(tasks.begin(), tasks.end(), t.name) == tasks.end(); });
   // The figures of the `stats` command and --stats-json, as they are: one schema for all three.
   return fmt::format(R"({{"kind": "timing", "seq": {}, "t_ns": {}, "stats": {}}})", seq, t_ns,
-                     stats_json(all, gate_.clock(), gate_.feed().switches()));
+                     stats_json(all, gate_.clock(), gate_.feed().switches(), false, JsonLayout::kCompact));
 }
 
 bool ApiStream::send_events(std::uint64_t& cursor) {

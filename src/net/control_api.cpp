@@ -311,7 +311,8 @@ ApiResponse ControlApi::command(Role role, std::string_view body) {
     if (done.ok) assembly_json(c, subsystem, more);
     if (done.ok && c.verb == Verb::kStats) {
       const auto tasks = subsystem.snapshot();
-      json all = json::parse(stats_json(tasks, subsystem.clock(), subsystem.switches().size()));
+      json all =
+          json::parse(stats_json(tasks, subsystem.clock(), subsystem.switches().size(), false, JsonLayout::kCompact));
       if (!c.args.empty()) all["tasks"] = json{{c.args[0], all["tasks"][c.args[0]]}};
       more["stats"] = std::move(all);
     }

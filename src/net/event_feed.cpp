@@ -76,7 +76,8 @@ void EventFeed::observe(const Subsystem& subsystem, const std::vector<Event>& ev
   observed_ = true;
 
   for (const auto& e : events)
-    publish(dump(json{{"type", "log"}, {"t_ns", e.time_ns}, {"task", e.task}, {"text", e.text}}));
+    if (!e.is_switch)  // its record came above, as the switch event
+      publish(dump(json{{"type", "log"}, {"t_ns", e.time_ns}, {"task", e.task}, {"text", e.text}}));
 }
 
 void EventFeed::publish(std::string text) {

@@ -176,7 +176,7 @@ Result<SwitchRecord> Reconfiguration::switch_to(std::string_view name, std::stri
   requests_.clear();
   std::fill(served_.begin(), served_.end(), -1);
   events_.collect(tasks_);
-  events_.add(Event{record.committed_ns, "", describe(record)});
+  events_.add(Event{record.committed_ns, "", describe(record), true});
   history_.push_back(record);
   if (!committed)
     return make_error(committed.error().code,

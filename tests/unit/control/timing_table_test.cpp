@@ -182,5 +182,15 @@ TEST(StatsJson, UnwritablePathIsAnError) {
   EXPECT_NE(r.error().message.find("/nonexistent-dir/stats.json"), std::string::npos);
 }
 
+TEST(StatsJson, CompactIsTheSameDocumentOnOneLine) {
+  auto tasks = sample();
+  tasks[0].stats.latency_histogram = {{1000, 5}, {2000, 7}, {4000, 1}};
+  const std::string indented = stats_json(tasks, ClockKind::kReal, 4);
+  const std::string compact = stats_json(tasks, ClockKind::kReal, 4, false, JsonLayout::kCompact);
+  EXPECT_EQ(nlohmann::json::parse(compact), nlohmann::json::parse(indented));
+  EXPECT_EQ(compact.find('\n'), std::string::npos);
+  EXPECT_LT(compact.size(), indented.size());
+}
+
 }  // namespace
 }  // namespace chimera

@@ -110,10 +110,15 @@ TEST_F(EventFeedTest, EachCommandsStateChangesComeAfterIt) {
 TEST_F(EventFeedTest, ASwitchComesWithItsRecordAndTheStatesItChanged) {
   gate_->run_for(5 * kMs);
   run("switch more");
+  // The shell prints the switch's line; the feed has the switch once, as its record.
+  EXPECT_NE(gate_->drain_events().find("switch main -> more"), std::string::npos);
   const auto got = items();
   std::vector<json> states;
   std::vector<json> switches;
-  for (const auto& item : got) (item["type"] == "switch" ? switches : states).push_back(item);
+  for (const auto& item : got) {
+    EXPECT_NE(item["type"], "log") << item;
+    (item["type"] == "switch" ? switches : states).push_back(item);
+  }
   ASSERT_EQ(switches.size(), 1U) << json(got);
   EXPECT_EQ(switches[0]["from"], "main");
   EXPECT_EQ(switches[0]["to"], "more");
