@@ -68,6 +68,9 @@ KEYS = [
         "Figure 4's tasks' release latency p99 with 10 clients streaming 20 variables at 1 kHz / without, worst task"),
     Key("api_round_trip_ns_p50", "ns", "a command (get theta_m) over HTTP on loopback, request to reply, p50"),
     Key("api_round_trip_ns_p99", "ns", "the same, p99"),
+    Key("api_round_trip_keepalive_ns_p50", "ns",
+        "the same command on one connection kept alive (a browser's fetch, a script's session), p50"),
+    Key("api_round_trip_keepalive_ns_p99", "ns", "the same, p99"),
     Key("api_memory_100_clients_kb", "kB", "the chimera process's resident memory with 100 clients connected"),
     Key("dds_raw_array_latency_ns_p50", "ns",
         "a Float64MultiArray of 9 doubles to another process through raw Cyclone DDS (the bridge's QoS), p50"),
@@ -187,7 +190,10 @@ GOALS = [
          lambda r: r["api_stream_latency_p99_ratio"] <= 1.05 if _have(r, "api_stream_latency_p99_ratio") else None,
          lambda r: (f"{r['api_stream_latency_p99_ratio']:.2f}x with 10 clients"
                     + (f"; command round trip p50 {_fmt(r['api_round_trip_ns_p50'])}, "
-                       f"p99 {_fmt(r['api_round_trip_ns_p99'])}" if _have(r, "api_round_trip_ns_p50") else ""))),
+                       f"p99 {_fmt(r['api_round_trip_ns_p99'])}" if _have(r, "api_round_trip_ns_p50") else "")
+                    + (f" (kept alive: p50 {_fmt(r['api_round_trip_keepalive_ns_p50'])}, "
+                       f"p99 {_fmt(r['api_round_trip_keepalive_ns_p99'])})"
+                       if _have(r, "api_round_trip_keepalive_ns_p50") else ""))),
     Goal("a DDS-bridged variable within 1.1x of raw Cyclone DDS (p50 and p99)",
          ["dds_bridge_latency_p50_ratio", "dds_bridge_latency_p99_ratio"],
          lambda r: (r["dds_bridge_latency_p50_ratio"] <= 1.1 and r["dds_bridge_latency_p99_ratio"] <= 1.1)

@@ -2,7 +2,7 @@
 // variables over /api/stream, and commands' round trips, against a running chimera.
 //
 //   node --experimental-websocket bench/net/api_load.mjs stream URL TOKEN CLIENTS RATE_HZ SECONDS VAR,VAR,...
-//   node --experimental-websocket bench/net/api_load.mjs roundtrip URL TOKEN COUNT
+//   node --experimental-websocket bench/net/api_load.mjs roundtrip URL TOKEN COUNT [keepalive]
 //
 // URL is http://127.0.0.1:PORT/. Prints one JSON object on stdout.
 
@@ -61,10 +61,11 @@ async function stream(clients, rateHz, seconds, variables) {
   return { clients, accepted, refused, variables: variables.length, rate_hz: rateHz, seconds: elapsed, frames, frames_per_client_per_s: accepted ? frames / accepted / elapsed : 0 };
 }
 
-// One request on a new connection each, as `curl` sends it: the round trip a script sees.
-function command(url, body) {
+// One request: on a new connection each (agent false), as `curl` sends it, or on one kept open
+// (a keep-alive agent), as a browser's fetch and a script's session send them.
+function command(url, body, agent) {
   return new Promise((resolve, reject) => {
-    const req = http.request(url, { method: 'POST', agent: false, headers: { Authorization: `Bearer ${token}`, 'Content-Type': 'application/json', 'Content-Length': Buffer.byteLength(body) } }, (res) => {
+    const req = http.request(url, { method: 'POST', agent, headers: { Authorization: `Bearer ${token}`, 'Content-Type': 'application/json', 'Content-Length': Buffer.byteLength(body) } }, (res) => {
       res.on('data', () => {});
       res.on('end', () => (res.statusCode === 200 ? resolve() : reject(new Error(`HTTP ${res.statusCode}`))));
     });
@@ -73,16 +74,18 @@ function command(url, body) {
   });
 }
 
-async function roundtrip(count) {
+async function roundtrip(count, keepAlive) {
   const times = [];
   const url = `${base}api/command`;
+  const agent = keepAlive ? new http.Agent({ keepAlive: true, maxSockets: 1 }) : false;
   for (let i = 0; i < count; ++i) {
     const t0 = process.hrtime.bigint();
-    await command(url, '{"command": "get theta_m"}');
+    await command(url, '{"command": "get theta_m"}', agent);
     times.push(Number(process.hrtime.bigint() - t0));
   }
+  if (agent) agent.destroy();
   times.sort((a, b) => a - b);
-  return { count, connection: 'new per request', p50_ns: percentile(times, 0.5), p99_ns: percentile(times, 0.99), max_ns: times[times.length - 1] };
+  return { count, connection: keepAlive ? 'kept alive' : 'new per request', p50_ns: percentile(times, 0.5), p99_ns: percentile(times, 0.99), max_ns: times[times.length - 1] };
 }
 
 let result;
@@ -90,7 +93,7 @@ if (mode === 'stream') {
   const [clients, rate, seconds, vars] = rest;
   result = await stream(Number(clients), Number(rate), Number(seconds), vars.split(','));
 } else if (mode === 'roundtrip') {
-  result = await roundtrip(Number(rest[0]));
+  result = await roundtrip(Number(rest[0]), rest[1] === 'keepalive');
 } else {
   console.error(`api_load: unknown mode ${mode}`);
   process.exit(2);

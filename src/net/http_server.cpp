@@ -65,7 +65,10 @@ Result<std::unique_ptr<HttpServer>> HttpServer::start(ControlApi& api, const Lis
   const std::string threads = std::to_string(kThreads + kMaxStreams);
   const std::string timeout = std::to_string(kRequestTimeoutMs);
   // No document_root: civetweb serves no file of its own, only the handlers below.
-  std::array<const char*, 13> options{"listening_ports",
+  // tcp_nodelay: civetweb writes a reply's headers and body apart; with Nagle's algorithm the
+  // body then waits for the client's delayed ACK of the headers, 40 ms a request on a connection
+  // kept alive (measured: 44 ms a `get`, where a new connection per request took 0.4 ms).
+  std::array<const char*, 15> options{"listening_ports",
                                       ports.c_str(),
                                       "num_threads",
                                       threads.c_str(),
@@ -77,6 +80,8 @@ Result<std::unique_ptr<HttpServer>> HttpServer::start(ControlApi& api, const Lis
                                       "2000",
                                       "max_request_size",
                                       "16384",
+                                      "tcp_nodelay",
+                                      "1",
                                       nullptr};
   mg_callbacks callbacks{};
   callbacks.log_message = log_message;
