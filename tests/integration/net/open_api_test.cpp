@@ -201,7 +201,15 @@ TEST_F(OpenApiTest, AnOpenedFileWithAModuleProcessRunsItOnTheRealClock) {
   auto p = start("real");
   ASSERT_GT(port_, 0) << p->err();
   const std::string name = unique_name();
-  const std::string text = renamed(read_text(std::filesystem::path(CHIMERA_EXAMPLES_DIR) / "visual_servo.yaml"), name);
+  std::string text = renamed(read_text(std::filesystem::path(CHIMERA_EXAMPLES_DIR) / "visual_servo.yaml"), name);
+  // Its hard tasks soft: a shared machine may miss a 1 ms deadline, which would end the run with
+  // 1 and is not this test's subject.
+  std::size_t softened = 0;
+  for (auto at = text.find("    period: 1ms\n"); at != std::string::npos; at = text.find("    period: 1ms\n", at + 1)) {
+    text.insert(at + 16, "    criticality: soft\n");
+    ++softened;
+  }
+  ASSERT_EQ(softened, 5U) << "the example changed: adapt this test";
   const HttpResponse opened = open("visual_servo.yaml", text);
   ASSERT_EQ(opened.status, 200) << opened.body << p->err();
   EXPECT_REPLY(run("wait 500ms"), 200);
