@@ -272,12 +272,7 @@ void Subsystem::stop() {
   std::lock_guard<std::mutex> lock(m.ops_mutex);
   if (m.stopped) return;
   m.executive->begin_stop();  // a task stuck in a method delays the stop by a bound, not for ever
-  // The paper's two-step termination, every task off, then every task killed, signal by signal
-  // so that what a module's kill reports is kept; then the executive ends its threads.
-  for (std::size_t i = 0; i < m.tasks->size(); ++i)
-    if ((*m.tasks)[i].state() == TaskState::kOn) (void)m.executive->signal(i, Signal::kOff);
-  for (std::size_t i = 0; i < m.tasks->size(); ++i)
-    if ((*m.tasks)[i].state() != TaskState::kNotCreated) m.note_kill(i, m.executive->signal(i, Signal::kKill));
+  m.off_then_kill_every_task();
   m.executive->shutdown();
   m.stopped = true;
   m.events->collect(*m.tasks);  // what off and kill reported stays readable, as do the tasks' figures

@@ -81,6 +81,14 @@ struct Subsystem::Impl {
     std::lock_guard<std::mutex> notes(notes_mutex);
     kill_faults[task] = killed.error().message;
   }
+  /// The paper's two-step termination (stop, open): every task ON turned off, then every created
+  /// task killed, signal by signal, so that what a module's kill reports is kept. Under ops_mutex.
+  void off_then_kill_every_task() {
+    for (std::size_t i = 0; i < tasks->size(); ++i)
+      if ((*tasks)[i].state() == TaskState::kOn) (void)executive->signal(i, Signal::kOff);
+    for (std::size_t i = 0; i < tasks->size(); ++i)
+      if ((*tasks)[i].state() != TaskState::kNotCreated) note_kill(i, executive->signal(i, Signal::kKill));
+  }
   /// Whether task `i` was removed by the live assembly.
   [[nodiscard]] bool is_removed(std::size_t i) const {
     std::lock_guard<std::mutex> notes(notes_mutex);

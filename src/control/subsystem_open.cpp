@@ -43,10 +43,7 @@ Result<void> Subsystem::replace(SubsystemSpec next) {
     std::lock_guard<std::mutex> lock(m.ops_mutex);
     serve_again = m.serving && !m.stopped;
     if (m.stopped) return make_error(Errc::kState, "the subsystem is stopped");
-    for (std::size_t i = 0; i < m.tasks->size(); ++i)
-      if ((*m.tasks)[i].state() == TaskState::kOn) (void)m.executive->signal(i, Signal::kOff);
-    for (std::size_t i = 0; i < m.tasks->size(); ++i)
-      if ((*m.tasks)[i].state() != TaskState::kNotCreated) m.note_kill(i, m.executive->signal(i, Signal::kKill));
+    m.off_then_kill_every_task();
     m.events->collect(*m.tasks);
     for (std::size_t i = 0; i < m.tasks->size(); ++i) {
       const Task& task = (*m.tasks)[i];
