@@ -1,6 +1,9 @@
 // chimera __worker --file FILE --process NAME --table NAME --socket-fd N --block-fd N --life N [--config NAME]
-// [--no-realtime] [--cpu-time] [--rt-check]: a module process (docs/processes.md). Not for people:
-// the main process of `chimera run` starts it, and it is left out of the help.
+// [--no-realtime] [--cpu-time] [--rt-check] [--history-fd N --record-seconds S]: a module process (docs/processes.md).
+// Not for people: the main process of `chimera run` starts it, and it is left out of the help.
+
+#include <cstdlib>
+#include <string>
 
 #include <CLI/CLI.hpp>
 
@@ -24,6 +27,10 @@ int worker_command(int argc, char** argv) {
   app.add_option("--socket-fd", args.socket_fd)->required();
   app.add_option("--block-fd", args.block_fd)->required();
   app.add_option("--life", args.life)->required();
+  app.add_option("--history-fd", args.history_fd);
+  std::string record_seconds =
+      "0";  // read with strtod, as fmt wrote it: exactly that double (CLI11 goes through long double)
+  app.add_option("--record-seconds", record_seconds);
   auto* config_opt = app.add_option("--config", config);
   app.add_flag("--no-realtime", no_realtime);
   app.add_flag("--cpu-time", args.measure_cpu_time);
@@ -34,6 +41,7 @@ int worker_command(int argc, char** argv) {
     return app.exit(e) == 0 ? kExitOk : kExitInvalid;
   }
   args.realtime_priorities = !no_realtime;
+  args.record_seconds = std::strtod(record_seconds.c_str(), nullptr);
   if (config_opt->count() > 0) args.configuration = config;
   // The same file and plugins as the main process: the tasks' indices are the same.
   auto spec = load_file(file, args.configuration);

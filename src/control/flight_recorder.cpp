@@ -45,12 +45,14 @@ class OutFile {
     if (file_ != nullptr && std::fwrite(text.data(), 1, text.size(), file_) != text.size()) failed_ = errno;
   }
   Result<void> close() {
-    if (file_ == nullptr) return make_error(Errc::kSystem, fmt::format("dump: cannot write {}: {}", path_, std::generic_category().message(errno)));
+    if (file_ == nullptr)
+      return make_error(Errc::kSystem,
+                        fmt::format("dump: cannot write {}: {}", path_, std::generic_category().message(errno)));
     const int closed = std::fclose(file_) == 0 ? 0 : errno;
     file_ = nullptr;
     if (failed_ != 0 || closed != 0)
-      return make_error(Errc::kSystem,
-                        fmt::format("dump: cannot write {}: {}", path_, std::generic_category().message(failed_ != 0 ? failed_ : closed)));
+      return make_error(Errc::kSystem, fmt::format("dump: cannot write {}: {}", path_,
+                                                   std::generic_category().message(failed_ != 0 ? failed_ : closed)));
     return {};
   }
 
@@ -90,8 +92,10 @@ FlightRecorder::FlightRecorder(const ResolvedSubsystem& resolved, const GlobalTa
     std::size_t total = 0;
     for (std::size_t v = 0; v < var_hz.size(); ++v)
       if (var_hz[v] > 0)
-        total += ring_bytes(capacity_for(s, var_hz[v]), static_cast<std::uint32_t>(table.shape(static_cast<VarIndex>(v)).bytes()));
-    for (std::size_t i = 0; i < tasks.size(); ++i) total += ring_bytes(capacity_for(s, rate_hz(tasks[i])), sizeof(CycleRecord));
+        total += ring_bytes(capacity_for(s, var_hz[v]),
+                            static_cast<std::uint32_t>(table.shape(static_cast<VarIndex>(v)).bytes()));
+    for (std::size_t i = 0; i < tasks.size(); ++i)
+      total += ring_bytes(capacity_for(s, rate_hz(tasks[i])), sizeof(CycleRecord));
     return total;
   };
   if (const std::size_t wanted = bytes_for(seconds_); wanted > kMostBytes) {
@@ -110,9 +114,34 @@ FlightRecorder::FlightRecorder(const ResolvedSubsystem& resolved, const GlobalTa
     variables_.push_back({var, ring});
   }
   for (std::size_t i = 0; i < tasks.size(); ++i)
-    timing_ring_.push_back(static_cast<std::int32_t>(rings_.add(capacity_for(seconds_, rate_hz(tasks[i])), sizeof(CycleRecord))));
-  rings_.allocate();
-  for (std::size_t i = 0; i < tasks.size(); ++i) tasks[i].keep_history(&rings_, timing_ring_[i], ring_of_var_);
+    timing_ring_.push_back(
+        static_cast<std::int32_t>(rings_.add(capacity_for(seconds_, rate_hz(tasks[i])), sizeof(CycleRecord))));
+}
+
+void FlightRecorder::bind_tasks() noexcept {
+  for (std::size_t i = 0; i < tasks_.size(); ++i) tasks_[i].keep_history(&rings_, timing_ring_[i], ring_of_var_);
+}
+
+Result<std::unique_ptr<FlightRecorder>> FlightRecorder::create(const ResolvedSubsystem& resolved,
+                                                               const GlobalTable& table, TaskSet& tasks, double seconds,
+                                                               Memory memory) {
+  std::unique_ptr<FlightRecorder> recorder(new FlightRecorder(resolved, table, tasks, seconds));
+  if (memory == Memory::kPrivate) {
+    recorder->rings_.allocate();
+  } else if (auto made = recorder->rings_.allocate_shared(); !made) {
+    return made.error();
+  }
+  recorder->bind_tasks();
+  return recorder;
+}
+
+Result<std::unique_ptr<FlightRecorder>> FlightRecorder::attach(const ResolvedSubsystem& resolved,
+                                                               const GlobalTable& table, TaskSet& tasks, double seconds,
+                                                               int fd) {
+  std::unique_ptr<FlightRecorder> recorder(new FlightRecorder(resolved, table, tasks, seconds));
+  if (auto mapped = recorder->rings_.attach(fd); !mapped) return mapped.error();
+  recorder->bind_tasks();
+  return recorder;
 }
 
 Result<void> FlightRecorder::write_variables(const std::string& path) const {
@@ -161,9 +190,9 @@ Result<void> FlightRecorder::write_timing(const std::string& path) const {
                           static_cast<std::int64_t>(r.words[2]), r.words[3]};
       const bool skipped = (c.flags & CycleRecord::kSkipped) != 0;
       out.put(fmt::format("{},{},{},{},{},{},{},{},{}\n", tasks_[i].name(), static_cast<double>(r.time_ns) / 1e9,
-                          skipped ? 0 : c.latency_ns, c.exec_ns, c.response_ns, (c.flags & CycleRecord::kMissed) != 0 ? 1 : 0,
-                          (c.flags & CycleRecord::kOverrun) != 0 ? 1 : 0, (c.flags & CycleRecord::kFailed) != 0 ? 1 : 0,
-                          skipped ? c.latency_ns : 0));
+                          skipped ? 0 : c.latency_ns, c.exec_ns, c.response_ns,
+                          (c.flags & CycleRecord::kMissed) != 0 ? 1 : 0, (c.flags & CycleRecord::kOverrun) != 0 ? 1 : 0,
+                          (c.flags & CycleRecord::kFailed) != 0 ? 1 : 0, skipped ? c.latency_ns : 0));
     }
   }
   return out.close();
@@ -171,9 +200,10 @@ Result<void> FlightRecorder::write_timing(const std::string& path) const {
 
 Result<void> FlightRecorder::write_constants(const std::string& path) const {
   OutFile out(path);
-  out.put("# The constants the tasks produced (out-consts), as they stood at the dump: a `constants:`\n"
-          "# map for a file that runs a task of this dump without their producers (log_player, docs/flight-recorder.md).\n"
-          "constants:\n");
+  out.put(
+      "# The constants the tasks produced (out-consts), as they stood at the dump: a `constants:`\n"
+      "# map for a file that runs a task of this dump without their producers (log_player, docs/flight-recorder.md).\n"
+      "constants:\n");
   for (const VarIndex v : constants_) {
     const VarShape shape = table_.shape(v);
     std::vector<std::byte> bytes(shape.bytes());
@@ -191,9 +221,10 @@ Result<void> FlightRecorder::dump(const std::string& dir, const std::string& why
   if (auto r = write_variables(dir + "/variables.csv"); !r) return r;
   if (auto r = write_timing(dir + "/timing.csv"); !r) return r;
   OutFile summary(dir + "/summary.txt");
-  summary.put(fmt::format("chimera flight recorder dump\nwhy: {}\nat: t = {} s\nkept: the last {:.3g} s of every "
-                          "produced variable and of every task's cycles\n\n",
-                          why, static_cast<double>(now_ns) / 1e9, seconds_));
+  summary.put(
+      fmt::format("chimera flight recorder dump\nwhy: {}\nat: t = {} s\nkept: the last {:.3g} s of every "
+                  "produced variable and of every task's cycles\n\n",
+                  why, static_cast<double>(now_ns) / 1e9, seconds_));
   for (const auto& line : task_lines) summary.put(line + "\n");
   if (auto r = summary.close(); !r) return r;
   OutFile spec(dir + "/subsystem.yaml");

@@ -6,6 +6,7 @@
 // Private to the control part.
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -24,11 +25,21 @@ class FlightRecorder {
   /// Records a ring holds at most, whatever its rate.
   static constexpr std::uint32_t kMostRecords = 1U << 20;
 
+  /// Where the rings live: this process's memory, or a memfd that module processes map too, so
+  /// that their tasks record what they write and how they cycle (docs/processes.md).
+  enum class Memory { kPrivate, kShared };
+
   /// Rings for `seconds` of history of every variable that a task of `resolved` produces (at its
   /// fastest producer's rate) and of every task's cycles, and every task of `tasks` writing into
-  /// them. `shortened` is set when the memory bound made the history shorter than asked: its
-  /// length is then seconds(). Not real-time safe.
-  FlightRecorder(const ResolvedSubsystem& resolved, const GlobalTable& table, TaskSet& tasks, double seconds);
+  /// them. When the memory bound makes the history shorter than asked, shortened() is set and
+  /// seconds() is its length. Fails only for shared memory that cannot be had. Not real-time safe.
+  static Result<std::unique_ptr<FlightRecorder>> create(const ResolvedSubsystem& resolved, const GlobalTable& table,
+                                                        TaskSet& tasks, double seconds, Memory memory);
+  /// A module process's side: the rings the main process made shared, open here as `fd` (kept),
+  /// laid out again from the same file and its seconds() (so unshortened), and the tasks of
+  /// `tasks` writing into them. Refused when the layouts differ. Not real-time safe.
+  static Result<std::unique_ptr<FlightRecorder>> attach(const ResolvedSubsystem& resolved, const GlobalTable& table,
+                                                        TaskSet& tasks, double seconds, int fd);
   FlightRecorder(const FlightRecorder&) = delete;
   FlightRecorder& operator=(const FlightRecorder&) = delete;
   FlightRecorder(FlightRecorder&&) = delete;
@@ -39,6 +50,8 @@ class FlightRecorder {
   [[nodiscard]] double seconds() const noexcept { return seconds_; }
   [[nodiscard]] bool shortened() const noexcept { return shortened_; }
   [[nodiscard]] std::size_t bytes() const noexcept { return rings_.bytes(); }
+  /// The shared rings' memfd, for a module process to inherit; -1 when private.
+  [[nodiscard]] int shared_fd() const noexcept { return rings_.fd(); }
 
   /// Writes what it holds into directory `dir` (made if missing; its files replaced):
   /// variables.csv (a data_logger log: t, then each element, one row per instant a variable was
@@ -55,6 +68,9 @@ class FlightRecorder {
     VarIndex var = 0;
     std::size_t ring = 0;
   };
+  // Lays the rings out; the block is made (or attached) and the tasks bound by create or attach.
+  FlightRecorder(const ResolvedSubsystem& resolved, const GlobalTable& table, TaskSet& tasks, double seconds);
+  void bind_tasks() noexcept;
   Result<void> write_variables(const std::string& path) const;
   Result<void> write_timing(const std::string& path) const;
   Result<void> write_constants(const std::string& path) const;
@@ -62,10 +78,10 @@ class FlightRecorder {
   const GlobalTable& table_;
   TaskSet& tasks_;
   HistoryRings rings_;
-  std::vector<std::int32_t> ring_of_var_;   // per variable of the table, -1: not recorded
+  std::vector<std::int32_t> ring_of_var_;    // per variable of the table, -1: not recorded
   std::vector<RecordedVariable> variables_;  // the recorded ones, in table order
-  std::vector<std::int32_t> timing_ring_;   // per task
-  std::vector<VarIndex> constants_;         // the out-consts of the tasks, in table order
+  std::vector<std::int32_t> timing_ring_;    // per task
+  std::vector<VarIndex> constants_;          // the out-consts of the tasks, in table order
   double seconds_ = 0;
   bool shortened_ = false;
 };

@@ -18,6 +18,7 @@
 #include "exec/process_protocol.hpp"
 #include "exec/task_block.hpp"
 #include "exec/task_set.hpp"
+#include "flight_recorder.hpp"
 
 namespace chimera {
 
@@ -96,6 +97,16 @@ int run_module_process(const SubsystemSpec& spec, const Registry& registry, cons
   }
   TaskSet tasks(resolved, *table, nullptr, shared);
   for (Task* t : tasks.pointers()) t->set_rt_check(args.rt_check);
+  // Its tasks record what they write and how they cycle in the rings the main process dumps.
+  std::unique_ptr<FlightRecorder> recorder;
+  if (args.history_fd >= 0) {
+    auto attached = FlightRecorder::attach(resolved, *table, tasks, args.record_seconds, args.history_fd);
+    if (!attached) {
+      reply(sock, attached.error());
+      return 1;
+    }
+    recorder = std::move(*attached);
+  }
   EventLog events(tasks.size());  // the executive's own events; the tasks' are in the block, for the main process
   const ConfigurationSpec* start = spec.find_configuration(args.configuration.value_or(spec.start));
   ExecutiveSetup setup;

@@ -15,7 +15,6 @@
 #include <fmt/ranges.h>
 
 #include "chimera/exec/write_watch.hpp"
-
 #include "chimera/svt/global_table.hpp"
 #include "chimera/svt/value_codec.hpp"
 #include "exec/task_block.hpp"
@@ -55,7 +54,7 @@ namespace {
 // How the main process starts its module processes: the chimera binary in its worker mode, told
 // the file, the table and the options of this run.
 ProcessSetup process_setup(const SubsystemSpec& spec, const RunOptions& options, TaskBlock* block,
-                           const std::string& start) {
+                           const FlightRecorder* recorder, const std::string& start) {
   ProcessSetup p;
   p.block = block;
   p.worker_program = options.worker_program;
@@ -68,6 +67,12 @@ ProcessSetup process_setup(const SubsystemSpec& spec, const RunOptions& options,
   if (!options.realtime_priorities) p.worker_args.emplace_back("--no-realtime");
   if (options.measure_cpu_time) p.worker_args.emplace_back("--cpu-time");
   if (options.rt_check) p.worker_args.emplace_back("--rt-check");
+  if (recorder != nullptr) {
+    // The length the main process laid its rings out for (shortened already, if it was): the
+    // worker lays them out again from it, and maps the same block (fmt's shortest form reads back exactly).
+    p.history_fd = recorder->shared_fd();
+    p.worker_args.insert(p.worker_args.end(), {"--record-seconds", fmt::format("{}", recorder->seconds())});
+  }
   return p;
 }
 
@@ -122,9 +127,14 @@ Result<void> Subsystem::Impl::build_runtime(const std::string& configuration, st
     m.removed.assign(m.tasks->size(), false);
   }
   for (Task* t : m.tasks->pointers()) t->set_rt_check(m.options.rt_check);
-  m.recorder = m.options.record_seconds > 0
-                   ? std::make_unique<FlightRecorder>(resolved, *m.table, *m.tasks, m.options.record_seconds)
-                   : nullptr;
+  m.recorder = nullptr;
+  if (m.options.record_seconds > 0) {
+    // Shared when module processes run tasks: they write into the same rings (docs/processes.md).
+    auto made = FlightRecorder::create(resolved, *m.table, *m.tasks, m.options.record_seconds,
+                                       m.block ? FlightRecorder::Memory::kShared : FlightRecorder::Memory::kPrivate);
+    if (!made) return made.error();
+    m.recorder = std::move(*made);
+  }
   m.dumped_failure.assign(m.tasks->size(), 0);
   ExecutiveSetup setup;
   setup.clock = m.options.clock;
@@ -136,7 +146,7 @@ Result<void> Subsystem::Impl::build_runtime(const std::string& configuration, st
   setup.configuration = config->tasks;
   setup.events = m.events.get();
   setup.start_ns = start_ns;
-  if (m.block) setup.processes = process_setup(m.spec, m.options, m.block.get(), configuration);
+  if (m.block) setup.processes = process_setup(m.spec, m.options, m.block.get(), m.recorder.get(), configuration);
   m.executive = make_executive(std::move(setup));
   for (const auto& [variable, watch] : m.watches)
     if (const auto v = m.table->find(variable)) m.executive->watch_writes(*v, watch.get());

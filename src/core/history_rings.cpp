@@ -1,8 +1,16 @@
 #include "chimera/core/history_rings.hpp"
 
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <cstring>
+#include <string>
+#include <system_error>
 
 #include "chimera/core/invariant.hpp"
 
@@ -13,6 +21,14 @@ namespace {
 using Word = std::atomic_ref<std::uint64_t>;
 
 constexpr std::size_t kHeaderWords = 2;  // a record's stamp and time words, before its payload
+
+// A shared block of no rings still maps one word: a mapping, and a reservation, of nothing fails.
+std::size_t mapped_bytes(std::size_t bytes) { return std::max(bytes, sizeof(std::uint64_t)); }
+
+Error system_error(const char* what, const char* call) {
+  return make_error(Errc::kSystem, std::string("the flight recorder's ") + what + ": " + call +
+                                       " failed: " + std::generic_category().message(errno));
+}
 
 }  // namespace
 
@@ -29,16 +45,57 @@ std::size_t HistoryRings::add(std::uint32_t capacity, std::uint32_t payload_byte
   return rings_.size() - 1;
 }
 
+HistoryRings::~HistoryRings() {
+  if (fd_ >= 0) {
+    if (block_ != nullptr) ::munmap(block_, mapped_bytes(bytes()));
+    ::close(fd_);
+  }
+}
+
 void HistoryRings::allocate() {
   CHIMERA_INVARIANT(block_ == nullptr, "the block allocated twice");
   // NOLINTNEXTLINE(cppcoreguidelines-avoid-c-arrays): one block of a size known only now, never resized
-  block_ = std::make_unique<std::uint64_t[]>(words_);  // value-initialised: every word 0
+  private_ = std::make_unique<std::uint64_t[]>(words_);  // value-initialised: every word 0
+  block_ = private_.get();
+}
+
+Result<void> HistoryRings::map_shared(const char* what) {
+  void* p = ::mmap(nullptr, mapped_bytes(bytes()), PROT_READ | PROT_WRITE, MAP_SHARED, fd_, 0);
+  if (p == MAP_FAILED) return system_error(what, "mmap");
+  block_ = static_cast<std::uint64_t*>(p);
+  return {};
+}
+
+Result<void> HistoryRings::allocate_shared() {
+  CHIMERA_INVARIANT(block_ == nullptr && fd_ < 0, "the block allocated twice");
+  fd_ = ::memfd_create("chimera-history", MFD_CLOEXEC);  // no name in /dev/shm: nothing left behind
+  if (fd_ < 0) return system_error("block", "memfd_create");
+  // A new memfd reads as zeros: every ring empty. Reserved whole, as the global table is.
+  if (const int rc = ::posix_fallocate(fd_, 0, static_cast<off_t>(mapped_bytes(bytes()))); rc != 0) {
+    errno = rc;  // it returns the error rather than setting errno
+    return system_error("block", "posix_fallocate");
+  }
+  return map_shared("block");
+}
+
+Result<void> HistoryRings::attach(int fd) {
+  CHIMERA_INVARIANT(block_ == nullptr && fd_ < 0, "the block allocated twice");
+  fd_ = fd;
+  struct stat st {};
+  if (::fstat(fd_, &st) != 0) return system_error("shared block", "fstat");
+  if (static_cast<std::size_t>(st.st_size) != mapped_bytes(bytes()))
+    return make_error(Errc::kInvalidInput, "the flight recorder's shared block is " + std::to_string(st.st_size) +
+                                               " bytes, where its rings here take " +
+                                               std::to_string(mapped_bytes(bytes())) +
+                                               ": the main process laid them out differently");
+  return map_shared("shared block");
 }
 
 void HistoryRings::write(std::size_t r, std::int64_t time_ns, const void* payload) noexcept {
   const Ring& ring = rings_[r];
-  std::uint64_t* head = block_.get() + ring.offset;
-  // Relaxed: this thread is the ring's only writer, so it reads back its own last store.
+  std::uint64_t* head = block_ + ring.offset;
+  // Relaxed: this thread is the ring's only writer, so it reads back its own last store (or that of
+  // the writer before it, in this process or another, which a switch's commit ordered before it).
   const std::uint64_t w = Word(*head).load(std::memory_order_relaxed) + 1;
   std::uint64_t* record = head + 1 + ((w - 1) % ring.capacity) * (kHeaderWords + ring.payload_words);
   // Relaxed: the release stores of the words below order it before them (see the header).
@@ -66,7 +123,7 @@ std::uint64_t HistoryRings::written(std::size_t r) const noexcept {
 
 std::vector<HistoryRings::Record> HistoryRings::read(std::size_t r) const {
   const Ring& ring = rings_[r];
-  std::uint64_t* head = block_.get() + ring.offset;
+  std::uint64_t* head = block_ + ring.offset;
   const std::uint64_t last = written(r);
   const std::uint64_t first = last > ring.capacity ? last - ring.capacity + 1 : 1;
   std::vector<Record> out;

@@ -36,6 +36,7 @@ struct ProcessSetup {
   TaskBlock* block = nullptr;            // the tasks' shared slots; null: no module processes
   std::string worker_program;            // the chimera binary
   std::vector<std::string> worker_args;  // what every worker is told: the file, the table, options
+  int history_fd = -1;                   // the flight recorder's shared rings (-1: none kept)
 };
 
 /// What an executive is made from.

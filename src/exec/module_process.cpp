@@ -26,8 +26,8 @@ constexpr int kReplyTimeoutMs = 20'000;
 constexpr int kQuitTimeoutMs = 10'000;
 
 Error sys_error(const std::string& process, std::string_view what) {
-  return make_error(Errc::kSystem, fmt::format("process {}: {} failed: {}", process, what,
-                                               std::generic_category().message(errno)));
+  return make_error(Errc::kSystem,
+                    fmt::format("process {}: {} failed: {}", process, what, std::generic_category().message(errno)));
 }
 
 int pidfd_open(pid_t pid) { return static_cast<int>(::syscall(SYS_pidfd_open, pid, 0)); }
@@ -79,6 +79,7 @@ Result<void> ModuleProcess::start(const WorkerLaunch& launch) {
   args.insert(args.end(), launch.args.begin(), launch.args.end());
   args.insert(args.end(), {"--process", name_, "--socket-fd", std::to_string(pair[1]), "--block-fd",
                            std::to_string(launch.block_fd), "--life", std::to_string(index_)});
+  if (launch.history_fd >= 0) args.insert(args.end(), {"--history-fd", std::to_string(launch.history_fd)});
   std::vector<char*> argv;
   argv.reserve(args.size() + 1);
   for (auto& a : args) argv.push_back(a.data());
@@ -95,6 +96,7 @@ Result<void> ModuleProcess::start(const WorkerLaunch& launch) {
     // terminal's Ctrl-C for the main process, which stops it in order; no signal stays blocked.
     ::fcntl(pair[1], F_SETFD, 0);
     ::fcntl(launch.block_fd, F_SETFD, 0);
+    if (launch.history_fd >= 0) ::fcntl(launch.history_fd, F_SETFD, 0);
     ::setpgid(0, 0);
     sigset_t none;
     ::sigemptyset(&none);
@@ -114,7 +116,8 @@ Result<void> ModuleProcess::start(const WorkerLaunch& launch) {
     return e;
   }
   death_seen_ = false;
-  const std::uint64_t generation = generation_.fetch_add(1, std::memory_order_acq_rel) + 1;  // acq_rel: one order of starts
+  const std::uint64_t generation =
+      generation_.fetch_add(1, std::memory_order_acq_rel) + 1;  // acq_rel: one order of starts
   {
     // The supervisor's own descriptor of this start: it can never name a later process.
     std::lock_guard<std::mutex> lock(watch_mutex_);
@@ -144,8 +147,9 @@ Result<void> ModuleProcess::await_reply(ProcessReply& reply, std::int64_t timeou
     const int n = ::poll(fds, 2, static_cast<int>(timeout_ms));
     if (n < 0 && errno == EINTR) continue;
     if (n < 0) return sys_error(name_, "poll");
-    if (n == 0) return make_error(Errc::kSystem, fmt::format("process {}: no answer within {} s (stuck?)", name_,
-                                                             timeout_ms / 1000));
+    if (n == 0)
+      return make_error(Errc::kSystem,
+                        fmt::format("process {}: no answer within {} s (stuck?)", name_, timeout_ms / 1000));
     // A reply sent just before the end is still an answer: read it first.
     if ((fds[0].revents & POLLIN) != 0) {
       const ssize_t got = ::recv(socket_, &reply, sizeof reply, 0);

@@ -22,6 +22,7 @@ struct WorkerLaunch {
   std::string program;            // the chimera binary
   std::vector<std::string> args;  // after the worker mode's name; --process, --socket-fd follow
   int block_fd = -1;              // the task block's memfd, inherited at this number
+  int history_fd = -1;            // the flight recorder's rings (a memfd), inherited likewise; -1: none
 };
 
 class ModuleProcess {

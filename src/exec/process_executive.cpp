@@ -2,20 +2,19 @@
 
 #include <fcntl.h>
 #include <poll.h>
-#include <signal.h>
-#include <sys/syscall.h>
-#include <sys/eventfd.h>
-#include <unistd.h>
-
 #include <pthread.h>
+#include <signal.h>
+#include <sys/eventfd.h>
+#include <sys/syscall.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
-#include <charconv>
 #include <cerrno>
-#include <sstream>
+#include <charconv>
 #include <map>
 #include <mutex>
+#include <sstream>
 #include <string_view>
 #include <unordered_map>
 #include <utility>
@@ -45,7 +44,8 @@ ProcessExecutive::ProcessExecutive(ExecutiveSetup setup)
       events_(setup.events),
       realtime_(setup.realtime_priorities),
       block_(setup.processes.block),
-      launch_{setup.processes.worker_program, setup.processes.worker_args, setup.processes.block->fd()} {
+      launch_{setup.processes.worker_program, setup.processes.worker_args, setup.processes.block->fd(),
+              setup.processes.history_fd} {
   // One ModuleProcess per process name other than main, in order of first appearance.
   std::map<std::string, int> index;
   std::vector<bool> hosted(tasks_.size(), true);
@@ -174,7 +174,8 @@ void ProcessExecutive::watch_life(ModuleProcess& p, std::uint64_t generation, pi
     if (const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC); fd >= 0) {
       std::array<char, 1024> buffer{};
       ssize_t got = 0;
-      while ((got = ::read(fd, buffer.data(), buffer.size())) > 0) text.append(buffer.data(), static_cast<std::size_t>(got));
+      while ((got = ::read(fd, buffer.data(), buffer.size())) > 0)
+        text.append(buffer.data(), static_cast<std::size_t>(got));
       ::close(fd);
     }
     const auto paren = text.rfind(')');
@@ -392,13 +393,14 @@ void ProcessExecutive::check_heartbeats(std::vector<Watch>& watches) {
       const BusyIn method = slot.busy_in.load(std::memory_order_relaxed);  // ordered by the acquire above
       const std::int64_t busy = now - since;
       if (busy <= stuck_bound_ns(*tasks_[i], method)) continue;
-      const std::string reason = fmt::format("{} stuck in {}() for {:.0f} ms", tasks_[i]->name(),
-                                             busy_in_name(method), static_cast<double>(busy) / 1e6);
+      const std::string reason = fmt::format("{} stuck in {}() for {:.0f} ms", tasks_[i]->name(), busy_in_name(method),
+                                             static_cast<double>(busy) / 1e6);
       w.process->note_kill(w.generation, reason);
       // By the supervisor's own pidfd: only ever this start of the process.
       ::syscall(SYS_pidfd_send_signal, w.pidfd, SIGKILL, nullptr, 0);
       w.killed = true;
-      if (events_ != nullptr) events_->add(Event{now, "", fmt::format("process {}: {}; killed", w.process->name(), reason)});
+      if (events_ != nullptr)
+        events_->add(Event{now, "", fmt::format("process {}: {}; killed", w.process->name(), reason)});
       break;
     }
   }

@@ -1,23 +1,32 @@
 // The cross-process path allocates nothing (issue 15): a module process's body, the very function
 // `chimera __worker` runs (run_module_process), run on a thread of this process so that the
-// allocation guard sees it. Its tasks keep their states, statistics and events in a task block
-// and read and write the global table another owner created, as a worker's tasks do; this test
-// plays the main process's part over the command socket.
+// allocation guard sees it. Its tasks keep their states, statistics and events in a task block,
+// read and write the global table another owner created, and record into the flight recorder's
+// shared rings, as a worker's tasks do; this test plays the main process's part over the command
+// socket.
 
+#include <fcntl.h>
 #include <sys/socket.h>
 #include <time.h>
 #include <unistd.h>
 
 #include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
 #include <thread>
 
 #include <gtest/gtest.h>
 
 #include "chimera/config/loader.hpp"
+#include "chimera/config/verify.hpp"
 #include "chimera/control/module_process_main.hpp"
 #include "chimera/control/subsystem.hpp"
+#include "control/flight_recorder.hpp"
 #include "exec/process_protocol.hpp"
 #include "exec/task_block.hpp"
+#include "exec/task_set.hpp"
 #include "support/allocation_guard.hpp"
 #include "support/probe_module.hpp"
 
@@ -71,6 +80,15 @@ TEST(NoAllocationInModuleProcess, Figure4InAWorkerOnTheRealClock) {
   auto block = TaskBlock::create(n);
   ASSERT_TRUE(block.ok()) << block.error().message;
   block->set_epoch_ns(monotonic_now_ns());
+  // The flight recorder's rings, shared, as the main process of a run with module processes makes
+  // them: laid out from the same file over the same table (whose tasks here are never spawned).
+  const Resolution resolution = resolve_subsystem(in_worker, Registry::global());
+  auto table = GlobalTable::attach(spec->name + options.shm_suffix);
+  ASSERT_TRUE(table.ok()) << table.error().message;
+  TaskSet views(resolution.subsystem, *table, nullptr);
+  auto recorder = FlightRecorder::create(resolution.subsystem, *table, views, 2.0, FlightRecorder::Memory::kShared);
+  ASSERT_TRUE(recorder.ok()) << recorder.error().message;
+
   int sockets[2] = {-1, -1};
   ASSERT_EQ(::socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, sockets), 0);
   ModuleProcessArgs args;
@@ -78,6 +96,8 @@ TEST(NoAllocationInModuleProcess, Figure4InAWorkerOnTheRealClock) {
   args.table = spec->name + options.shm_suffix;
   args.socket_fd = sockets[1];
   args.block_fd = block->fd();
+  args.history_fd = ::fcntl((*recorder)->shared_fd(), F_DUPFD_CLOEXEC, 0);  // the worker keeps (and closes) its own
+  args.record_seconds = (*recorder)->seconds();
   args.realtime_priorities = false;
   int exit_code = -1;
   std::thread worker([&] { exit_code = run_module_process(in_worker, Registry::global(), args); });
@@ -118,6 +138,24 @@ TEST(NoAllocationInModuleProcess, Figure4InAWorkerOnTheRealClock) {
   EXPECT_TRUE(command(sockets[0], quit).ok());
   worker.join();
   EXPECT_EQ(exit_code, 0);
+
+  // What the worker's tasks recorded is in the shared rings, where the main process dumps it: a
+  // row for every cycle each task ran (the 2 s rings hold them all).
+  std::string dir = std::filesystem::temp_directory_path() / "chimera-rt-dump-XXXXXX";
+  ASSERT_NE(::mkdtemp(dir.data()), nullptr);
+  auto dumped = (*recorder)->dump(dir, "the test", 0, {}, "");
+  ASSERT_TRUE(dumped.ok()) << dumped.error().message;
+  std::ifstream file(dir + "/timing.csv");
+  const std::string timing((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  std::filesystem::remove_all(dir);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::string row_start = "\n" + in_worker.tasks[i].name + ",";
+    std::uint64_t rows = 0;
+    for (std::size_t at = timing.find(row_start); at != std::string::npos; at = timing.find(row_start, at + 1)) ++rows;
+    const std::uint64_t cycles = block->slot(i)->stats.snapshot().cycles;
+    EXPECT_GT(cycles, 0U) << in_worker.tasks[i].name;
+    EXPECT_GE(rows, cycles) << in_worker.tasks[i].name << ": its cycles in the shared rings";
+  }
   ::close(sockets[0]);
   ::close(sockets[1]);
 }

@@ -47,7 +47,8 @@ struct RunOptions {
   std::string worker_program;
   /// The flight recorder (docs/flight-recorder.md): how many seconds of every produced variable
   /// and of every task's cycles are kept in memory (0: none; a history that would need more than
-  /// 256 MiB is shortened to fit). Tasks in module processes are not recorded.
+  /// 256 MiB is shortened to fit). With module processes the rings are shared memory that their
+  /// tasks write into as well.
   double record_seconds = 0;
   /// Where the recorder's dump goes when a task enters ERROR: a directory below this one, named
   /// after the subsystem, the task and the time ("": no dump then).

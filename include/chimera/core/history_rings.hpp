@@ -13,6 +13,10 @@
 // the re-check sees it: the same argument as the state variable table's (docs/state-variables.md),
 // with release/acquire on each word instead of fences, which costs nothing on x86 and which
 // ThreadSanitizer understands.
+//
+// The block is private memory, or a memfd shared with module processes (docs/processes.md): the
+// main process creates it, a worker that declared the same rings attaches to it, and both write
+// and read the same records. Nothing in it is a pointer: a ring is found at an offset.
 
 #include <cstddef>
 #include <cstdint>
@@ -20,14 +24,16 @@
 #include <span>
 #include <vector>
 
+#include "chimera/core/result.hpp"
+
 namespace chimera {
 
 class HistoryRings {
  public:
   /// A ring's place in the block: offsets into it, never pointers.
   struct Ring {
-    std::size_t offset = 0;        // of its head word; its records follow
-    std::uint32_t capacity = 0;    // records
+    std::size_t offset = 0;      // of its head word; its records follow
+    std::uint32_t capacity = 0;  // records
     std::uint32_t payload_words = 0;
     std::uint32_t payload_bytes = 0;
   };
@@ -40,8 +46,25 @@ class HistoryRings {
   /// Declares a ring of `capacity` records of `payload_bytes` each (capacity >= 1); returns its
   /// number. Only before allocate(). Not real-time safe.
   std::size_t add(std::uint32_t capacity, std::uint32_t payload_bytes);
-  /// Allocates and zeroes the block for every ring declared. Not real-time safe.
+  HistoryRings() = default;
+  HistoryRings(const HistoryRings&) = delete;
+  HistoryRings& operator=(const HistoryRings&) = delete;
+  HistoryRings(HistoryRings&&) = delete;
+  HistoryRings& operator=(HistoryRings&&) = delete;
+  ~HistoryRings();
+
+  /// Allocates and zeroes the block for every ring declared, in this process's memory. Not
+  /// real-time safe.
   void allocate();
+  /// The same, in a memfd that other processes can map (fd()): reserved whole up front, so that a
+  /// full tmpfs is this error, never a SIGBUS on a write. Not real-time safe.
+  [[nodiscard]] Result<void> allocate_shared();
+  /// Maps the block another process made by allocate_shared() with the same rings declared, open
+  /// here as `fd` (the block keeps it); refused when its size is not this layout's. Not real-time
+  /// safe.
+  [[nodiscard]] Result<void> attach(int fd);
+  /// The shared block's memfd (close-on-exec), -1 when the block is private or not yet made.
+  [[nodiscard]] int fd() const noexcept { return fd_; }
   [[nodiscard]] std::size_t rings() const noexcept { return rings_.size(); }
   [[nodiscard]] const Ring& ring(std::size_t r) const noexcept { return rings_[r]; }
   /// Bytes of the block.
@@ -57,9 +80,14 @@ class HistoryRings {
   [[nodiscard]] std::vector<Record> read(std::size_t r) const;
 
  private:
+  Result<void> map_shared(const char* what);
+
   std::vector<Ring> rings_;
   std::size_t words_ = 0;
-  std::unique_ptr<std::uint64_t[]> block_;
+  // NOLINTNEXTLINE(cppcoreguidelines-avoid-c-arrays): one block of a size known only at allocate(), never resized
+  std::unique_ptr<std::uint64_t[]> private_;  // the private block, when it is one
+  std::uint64_t* block_ = nullptr;            // the block, private or mapped
+  int fd_ = -1;                               // the shared block's memfd
 };
 
 }  // namespace chimera

@@ -9,8 +9,10 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cstdlib>
 #include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -34,7 +36,8 @@ constexpr int kMaxSteps = 1500;
 
 std::string file_text(const TempDir& dir) {
   return "subsystem: fig4_processes\n"
-         "plugins: [" FAULTY_PLUGIN "]\n"
+         "plugins: [" FAULTY_PLUGIN
+         "]\n"
          "scheduler: rm\n"
          "tasks:\n"
          "  - {name: traj, module: joint_traj_gen, period: 1ms, criticality: soft}\n"
@@ -45,28 +48,35 @@ std::string file_text(const TempDir& dir) {
          "    period: 2ms\n"
          "    criticality: soft\n"
          "    process: faulty\n"
-         "    params: {after: 25, once_file: " + dir.file("segv.once") + "}\n"
+         "    params: {after: 25, once_file: " +
+         dir.file("segv.once") +
+         "}\n"
          "  - name: aborts\n"
          "    module: abort_in_cycle\n"
          "    period: 2ms\n"
          "    criticality: soft\n"
          "    process: aborting\n"
          "    rename: {faulty_count: abort_count}\n"
-         "    params: {after: 25, once_file: " + dir.file("abort.once") + "}\n"
+         "    params: {after: 25, once_file: " +
+         dir.file("abort.once") +
+         "}\n"
          "  - name: exits\n"
          "    module: exit_in_cycle\n"
          "    period: 2ms\n"
          "    criticality: soft\n"
          "    process: exiting\n"
          "    rename: {faulty_count: exit_count}\n"
-         "    params: {after: 25, once_file: " + dir.file("exit.once") + "}\n"
+         "    params: {after: 25, once_file: " +
+         dir.file("exit.once") +
+         "}\n"
          "  - name: spin\n"
          "    module: loop_in_cycle\n"
          "    period: 2ms\n"
          "    criticality: soft\n"
          "    process: spinning\n"
          "    rename: {faulty_count: spin_count}\n"
-         "    params: {after: 25, once_file: " + dir.file("spin.once") + "}\n";
+         "    params: {after: 25, once_file: " +
+         dir.file("spin.once") + "}\n";
 }
 
 constexpr const char* kFaulty[] = {"segv", "aborts", "exits", "spin"};
@@ -95,7 +105,8 @@ class ModuleProcessTest : public ::testing::Test {
     // (this process read its options at start).
     for (const char* var : {"ASAN_OPTIONS", "TSAN_OPTIONS"}) {
       const char* now = std::getenv(var);  // NOLINT(concurrency-mt-unsafe): before any worker or thread
-      const std::string value = (now != nullptr && *now != '\0' ? std::string(now) + ":" : std::string()) + "handle_segv=0";
+      const std::string value =
+          (now != nullptr && *now != '\0' ? std::string(now) + ":" : std::string()) + "handle_segv=0";
       ::setenv(var, value.c_str(), 1);  // NOLINT(concurrency-mt-unsafe): as above
     }
     const std::string path = dir_.file("fig4_processes.yaml");
@@ -108,15 +119,52 @@ class ModuleProcessTest : public ::testing::Test {
     options.realtime_priorities = false;  // the test runs anywhere; priorities are not its subject
     options.shm_suffix = "_" + std::to_string(::getpid());
     options.worker_program = CHIMERA_BIN;
+    adjust(options);
     auto made = Subsystem::create(*spec, Registry::global(), options);
     ASSERT_TRUE(made.ok()) << made.error().message;
     subsystem_ = std::move(*made);
     ASSERT_TRUE(subsystem_->start().ok());
   }
 
+  virtual void adjust(RunOptions& /*options*/) {}
+
   TempDir dir_;
   std::unique_ptr<Subsystem> subsystem_;
 };
+
+// The same subsystem with the flight recorder on, its dumps below the test's directory.
+class ModuleProcessRecorderTest : public ModuleProcessTest {
+ protected:
+  void adjust(RunOptions& options) override {
+    options.record_seconds = 2;
+    options.error_dump_dir = dumps();
+  }
+  [[nodiscard]] std::string dumps() const { return dir_.file("dumps"); }
+};
+
+// One column of a CSV file with a header, as text, by its header's name ("" cells for a short row).
+std::vector<std::string> csv_column(const std::string& path, const std::string& name) {
+  std::istringstream in(test::read_text(path));
+  std::string line;
+  std::getline(in, line);
+  const auto cells = [](const std::string& row) {
+    std::vector<std::string> out;
+    std::stringstream fields(row);
+    for (std::string cell; std::getline(fields, cell, ',');) out.push_back(cell);
+    return out;
+  };
+  const auto header = cells(line);
+  const auto at = std::find(header.begin(), header.end(), name);
+  EXPECT_NE(at, header.end()) << path << " has no column " << name;
+  if (at == header.end()) return {};
+  const auto k = static_cast<std::size_t>(at - header.begin());
+  std::vector<std::string> column;
+  while (std::getline(in, line)) {
+    const auto row = cells(line);
+    column.push_back(k < row.size() ? row[k] : std::string());
+  }
+  return column;
+}
 
 TEST_F(ModuleProcessTest, CrashesStopOnlyTheirTasksAndClearBringsThemBack) {
   Subsystem& s = *subsystem_;
@@ -185,6 +233,54 @@ TEST_F(ModuleProcessTest, TasksOfADeadProcessAreKilledByStop) {
   ASSERT_FALSE(on.ok());
   s.stop();
   for (const auto& t : s.snapshot()) EXPECT_EQ(t.state, TaskState::kNotCreated) << t.name;
+}
+
+// A module process's tasks write into the flight recorder's rings as the main process's do: the
+// dumps hold what the segfaulting task wrote, each of its values up to the last before its death,
+// and each of its cycles, beside Figure 4's in the main process.
+TEST_F(ModuleProcessRecorderTest, TheRecorderHoldsWhatAModuleProcessWroteUntilItDied) {
+  Subsystem& s = *subsystem_;
+  ASSERT_TRUE(run_until(s, [](const auto& all) { return task_of(all, "segv").state == TaskState::kError; }));
+  const std::string dump = dir_.file("operator-dump");
+  auto written = s.dump(dump, "the test");
+  ASSERT_TRUE(written.ok()) << written.error().message;
+
+  // faulty_count is 0 as init and on publish it, then the cycle's number: 1, 2, ... up to 24, the
+  // last cycle that returned (the 25th wrote through a null pointer before its outputs went out).
+  // Rows of other variables' instants repeat a value; none is missing, none is past 24.
+  std::vector<double> counts;
+  for (const auto& cell : csv_column(dump + "/variables.csv", "faulty_count[0]")) {
+    if (cell == "nan") continue;
+    const double v = std::stod(cell);
+    if (counts.empty() || v != counts.back()) counts.push_back(v);
+  }
+  std::string seen;
+  for (const double v : counts) seen += std::to_string(static_cast<int>(v)) + " ";
+  ASSERT_EQ(counts.size(), 25U) << "the values the worker's task wrote before its process died: " << seen;
+  for (std::size_t k = 0; k < counts.size(); ++k) EXPECT_EQ(counts[k], static_cast<double>(k)) << seen;
+
+  // timing.csv: a row for each of segv's 24 cycles that returned (the 25th never ended; a row of
+  // releases skipped, as a worker's late start may make, is not a cycle), and Figure 4's pid's
+  // rows beside them.
+  const auto task = csv_column(dump + "/timing.csv", "task");
+  const auto skipped = csv_column(dump + "/timing.csv", "skipped");
+  ASSERT_EQ(task.size(), skipped.size());
+  std::size_t segv_cycles = 0;
+  std::size_t pid_rows = 0;
+  for (std::size_t r = 0; r < task.size(); ++r) {
+    segv_cycles += task[r] == "segv" && skipped[r] == "0" ? 1 : 0;
+    pid_rows += task[r] == "pid" ? 1 : 0;
+  }
+  EXPECT_EQ(segv_cycles, 24U);
+  EXPECT_GT(pid_rows, 24U);
+
+  // The dump that the ERROR made by itself names the task.
+  s.run_for(kStepNs);
+  bool named = false;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(dumps(), ec))
+    named = named || test::read_text(entry.path().string() + "/summary.txt").find("segv") != std::string::npos;
+  EXPECT_TRUE(named) << "no dump below " << dumps() << " names segv";
 }
 
 }  // namespace
