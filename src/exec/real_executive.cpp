@@ -385,9 +385,9 @@ Result<void> RealExecutive::await(Worker& w, std::uint32_t seq) const {
 Result<void> RealExecutive::answering(Worker& w) {
   if (w.given_up)
     return make_error(Errc::kState,
-                      fmt::format("{}: stuck in cycle(), and given up: a task of the main process cannot be "
+                      fmt::format("{}: stuck in {}(), and given up: a task of the main process cannot be "
                                   "stopped or restarted; run a module you do not trust in a module process (process:)",
-                                  w.task->name()));
+                                  w.task->name(), busy_in_name(w.given_up_in)));
   TaskThread& t = *w.thread;
   if (!t.unanswered) return {};
   // Caught up: every member's last mail answered (acquire: what it did before answering is seen).
@@ -399,9 +399,9 @@ Result<void> RealExecutive::answering(Worker& w) {
     t.unanswered = false;
     return {};
   }
-  return make_error(Errc::kModuleFault,
-                    fmt::format("{}: its thread has not answered since an earlier signal (a method is stuck?)",
-                                w.task->name()));
+  return make_error(
+      Errc::kModuleFault,
+      fmt::format("{}: its thread has not answered since an earlier signal (a method is stuck?)", w.task->name()));
 }
 
 Result<void> RealExecutive::post(Worker& w, Mail mail) {
@@ -512,7 +512,8 @@ CommitOutcome RealExecutive::commit_switch(const SwitchCommit& commit) {
       for (const std::size_t i : joining) {
         const Worker& w = *workers_[i];
         const std::int64_t p = w.task->periodic() ? w.task->period_ns() : 1;
-        join.push_back(Mail{MailKind::kOnAt, Signal::kOn, release_policy::first_release_index(outcome.joins_from_ns, p)});
+        join.push_back(
+            Mail{MailKind::kOnAt, Signal::kOn, release_policy::first_release_index(outcome.joins_from_ns, p)});
       }
       if (auto on = post_all(joining, join); outcome.fault && !on) outcome.fault = on;
       for (const std::size_t i : joining)

@@ -97,11 +97,11 @@ class RealExecutive final : public Executive {
   /// The service thread's body, and one look at every task's running job (service_thread.cpp).
   void service_main(const ServiceHooks& hooks);
   void watch_overruns();
-  /// The stuck-task watch (stuck_cycles.cpp), in the main process only: a task of this process
-  /// inside cycle() longer than StuckBound is ERROR, its thread-mates move to a new thread, and
-  /// its own thread drops to SCHED_IDLE. The service thread's.
-  void give_up_stuck_cycles();
-  void give_up(Worker& w, std::int64_t since_ns, std::int64_t now_ns);
+  /// The stuck-task watch (stuck_methods.cpp), in the main process only: a task of this process
+  /// inside one module method longer than StuckBound is ERROR, its thread-mates move to a new
+  /// thread, and its own thread drops to SCHED_IDLE. The service thread's.
+  void give_up_stuck_methods();
+  void give_up(Worker& w, const Task::Busy& busy, std::int64_t now_ns);
   /// A given-up thread back at SCHED_IDLE, should a dispatcher's ranking have raised it again.
   void keep_given_up_idle();
 
@@ -118,8 +118,8 @@ class RealExecutive final : public Executive {
   std::vector<std::unique_ptr<TaskThread>> threads_;
   std::int64_t epoch_ns_ = 0;
   bool realtime_ = false;
-  std::mutex control_mutex_;  // one control request at a time; never taken by a task's thread
-  std::vector<std::atomic<WriteWatch*>> watches_;  // one a variable of the table, nullptr: none; never resized
+  std::mutex control_mutex_;                        // one control request at a time; never taken by a task's thread
+  std::vector<std::atomic<WriteWatch*>> watches_;   // one a variable of the table, nullptr: none; never resized
   std::int64_t reply_timeout_ns_ = 10'000'000'000;  // the control thread's: how long a signal waits for its answer
 
   // The service thread (service_thread.cpp) and what its overrun watch holds.
@@ -131,7 +131,7 @@ class RealExecutive final : public Executive {
   // illegal-configuration flag (a hard task's). The service thread's own.
   std::vector<std::int64_t> overdue_reported_;
   std::vector<bool> overdue_hold_;
-  bool gave_up_any_ = false;         // the service thread's: a stuck cycle was given up (stuck_cycles.cpp)
+  bool gave_up_any_ = false;         // the service thread's: a stuck method was given up (stuck_methods.cpp)
   std::int64_t stopped_at_ns_ = -1;  // after shutdown()
 };
 

@@ -115,6 +115,9 @@ bool Worker::handle(std::uint32_t seq) {
   if (turning_on && task->periodic() && mail.kind == MailKind::kSignal)
     precedence.scheduled.store(join, std::memory_order_release);  // release: pairs with successors' acquire load
   mailbox.reply = task->apply(request, now);
+  // Given up while stuck in the method: the signal stopped waiting long ago (answering() refuses
+  // the task now), and the thread-mates are another thread's. Nothing here is ours to change.
+  if (task->given_up()) return false;
   if (before != TaskState::kOn && task->state() == TaskState::kOn) {
     if (task->periodic()) schedule.k = join;
     schedule.held = mail.kind == MailKind::kOnHeld && task->periodic();

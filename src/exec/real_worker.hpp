@@ -42,7 +42,7 @@ struct TaskThread {
   std::atomic<bool> exiting{false};  // set before the answer to the mail that killed its last member
   bool unanswered = false;           // the control thread's: a mail went unanswered (a method is stuck)
   bool left_behind = false;          // the control thread's: shutdown() gave up joining it
-  bool given_up = false;             // the control thread's: stuck in a member's cycle(), its other members moved
+  bool given_up = false;             // the control thread's: stuck in a member's method, its other members moved
 
   /// The body: until no member is alive.
   void main();
@@ -87,7 +87,8 @@ struct Worker {
   // `group` instead, which never changes.
   TaskThread* thread = nullptr;
   int group = -1;         // its first thread's number: tasks that share a thread, or did, in data-flow order
-  bool given_up = false;  // the control thread's view (under the control mutex): its cycle was given up
+  bool given_up = false;  // the control thread's view (under the control mutex): its method was given up
+  BusyIn given_up_in = BusyIn::kCycle;  // which method that was, under the same mutex
 
   /// Requests from the control thread and the answers of the task's thread.
   struct Mailbox {

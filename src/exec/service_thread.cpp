@@ -8,7 +8,7 @@
 // So a job more than a tick past its deadline is reported once, and while it is a hard task's it
 // holds the illegal-configuration flag, so that the robot interfaces hold still. Once the job
 // ends, end_job's own handling follows (error(), then ERROR if it does not recover) and the hold
-// goes. A job stuck far longer is given up (stuck_cycles.cpp). Not on any task's real-time path.
+// goes. A job stuck far longer is given up (stuck_methods.cpp). Not on any task's real-time path.
 
 #include <fmt/format.h>
 
@@ -52,14 +52,14 @@ void RealExecutive::service_main(const ServiceHooks& hooks) {
 }
 
 void RealExecutive::watch_overruns() {
-  give_up_stuck_cycles();
+  give_up_stuck_methods();
   const std::int64_t now = now_ns();
   for (std::size_t i = 0; i < tasks_.size(); ++i) {
     const std::optional<std::int64_t> deadline = running_deadline(i);
     const bool overdue = deadline && now > *deadline + kWatchTickNs;
     const Task& t = *tasks_[i];
     // A hard task's overdue job holds the flag while it lasts: one hold, raised once, lowered once.
-    // A given-up task's ERROR holds the flag now (stuck_cycles.cpp).
+    // A given-up task's ERROR holds the flag now (stuck_methods.cpp).
     const bool hold = overdue && t.hard() && !workers_[i]->given_up;
     if (hold != overdue_hold_[i]) {
       if (hold)

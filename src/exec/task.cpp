@@ -62,10 +62,11 @@ void Task::note_rt_allocation() noexcept {
   // Once per task: a cycle that allocates does so every cycle, and the count tells the rest.
   if (shared_->stats.record_rt_allocation())
     shared_->events.push(timing_.release_ns, hook_name(static_cast<std::uint8_t>(rt_hook_)),
-                 "() allocated on the real-time path (--rt-check)");
+                         "() allocated on the real-time path (--rt-check)");
 }
 
-void Task::keep_history(HistoryRings* rings, std::int32_t timing_ring, std::span<const std::int32_t> ring_of_var) noexcept {
+void Task::keep_history(HistoryRings* rings, std::int32_t timing_ring,
+                        std::span<const std::int32_t> ring_of_var) noexcept {
   history_ = timing_ring >= 0 ? rings : nullptr;
   timing_ring_ = timing_ring;
   ring_of_var_ = ring_of_var;
@@ -99,8 +100,21 @@ Status Task::dispatch(Hook hook) noexcept {
 Status Task::call(Hook hook) noexcept {
   local_->pull_in_vars();
   const Status s = call_raw(hook);
+  // Given up while it ran: the task is ERROR, and its outputs are no longer this thread's to publish.
+  if (given_up_meanwhile()) return Status::fail("given up while stuck in a method");
   if (hook != Hook::kKill) local_->push_out_vars(timing_.release_ns);  // a killed module has nothing left to publish
   return s;
+}
+
+bool Task::given_up_meanwhile() noexcept {
+  if (given_up_ || method_scope_ == nullptr) return given_up_;
+  if (method_scope_->returned(method_scope_->method())) given_up_ = true;
+  return given_up_;
+}
+
+Error Task::given_up_error() const {
+  return make_error(Errc::kModuleFault,
+                    fmt::format("{}: stuck in a method, and given up; the task is in ERROR", spec_.name));
 }
 
 bool Task::recover(Hook hook, Status failure, std::int64_t now_ns) noexcept {
@@ -108,6 +122,7 @@ bool Task::recover(Hook hook, Status failure, std::int64_t now_ns) noexcept {
   timing_.fault = Fault::kMethodFailed;
   const Status handled = call(Hook::kError);
   timing_.fault = Fault::kNone;
+  if (given_up_) return false;  // the watch set ERROR, and the task is no longer ours
   if (handled.is_ok()) {
     shared_->events.push(now_ns, "error() recovered", nullptr);
     return true;
@@ -144,7 +159,7 @@ std::int64_t Task::begin_job(std::int64_t release_ns, std::int64_t start_ns) noe
     hook = Hook::kCycle;
     s = call_raw(Hook::kCycle);
   }
-  // Given up while stuck in there (give_up_cycle): the task is ERROR, and nothing more of it is ours.
+  // Given up while stuck in there (give_up): the task is ERROR, and nothing more of it is ours.
   if (busy.returned(s.is_ok() ? std::nullopt : std::optional(BusyIn::kError))) {
     job_.open = false;
     given_up_ = true;
@@ -153,7 +168,13 @@ std::int64_t Task::begin_job(std::int64_t release_ns, std::int64_t start_ns) noe
   if (!s.is_ok()) {
     local_->push_out_vars(release_ns);  // what the failed method wrote is published, as after any method
     job_.failed = true;
+    method_scope_ = &busy;  // error() is watched as the cycle was
     (void)recover(hook, s, start_ns);
+    method_scope_ = nullptr;
+    if (given_up_) {
+      job_.open = false;
+      return 0;
+    }
   }
   return spec_.virtual_exec_ns + module_->virtual_ns_;
 }
@@ -199,9 +220,12 @@ bool Task::reinit(std::int64_t now_ns) noexcept {
   if (state() != TaskState::kOn) return false;
   local_->pull_in_consts();
   reinits_.fetch_add(1, std::memory_order_relaxed);  // a counter read on its own
-  const BusyScope busy(*shared_, BusyIn::kReinit, now_ns);
+  BusyScope busy(*shared_, BusyIn::kReinit, now_ns);
+  method_scope_ = &busy;
   const Status s = call(Hook::kReinit);
-  if (!s.is_ok() && !recover(Hook::kReinit, s, now_ns)) return false;
+  const bool recovered = given_up_ || s.is_ok() || recover(Hook::kReinit, s, now_ns);
+  method_scope_ = nullptr;
+  if (given_up_ || !recovered) return false;
   return state() == TaskState::kOn;
 }
 
@@ -247,7 +271,8 @@ void Task::set_state(TaskState s) noexcept {
     shared_->ever_in_error.store(true, std::memory_order_relaxed);  // a latch, read on its own
     table_.raise_illegal_configuration();
   }
-  shared_->state.store(s, std::memory_order_release);  // release: what the method did is visible to whoever sees the state
+  shared_->state.store(s,
+                       std::memory_order_release);  // release: what the method did is visible to whoever sees the state
   if (before == TaskState::kError && s != TaskState::kError) table_.lower_illegal_configuration();
 }
 
@@ -258,15 +283,18 @@ Result<void> Task::apply(Signal signal, std::int64_t now_ns) {
                                                 state_name(from)));
   static constexpr std::array<BusyIn, 5> kMethodOf = {BusyIn::kInit, BusyIn::kOn, BusyIn::kOff, BusyIn::kKill,
                                                       BusyIn::kClear};
-  const BusyScope busy(*shared_, kMethodOf[static_cast<std::size_t>(signal)], now_ns);
+  BusyScope busy(*shared_, kMethodOf[static_cast<std::size_t>(signal)], now_ns);
+  method_scope_ = &busy;
+  Result<void> r = make_error(Errc::kState, "unknown signal");
   switch (signal) {
-    case Signal::kSpawn: return spawn(now_ns);
-    case Signal::kOn: return turn_on(now_ns);
-    case Signal::kOff: return turn_off(now_ns);
-    case Signal::kKill: return kill(now_ns);
-    case Signal::kClear: return clear(now_ns);
+    case Signal::kSpawn: r = spawn(now_ns); break;
+    case Signal::kOn: r = turn_on(now_ns); break;
+    case Signal::kOff: r = turn_off(now_ns); break;
+    case Signal::kKill: r = kill(now_ns); break;
+    case Signal::kClear: r = clear(now_ns); break;
   }
-  return make_error(Errc::kState, "unknown signal");
+  method_scope_ = nullptr;
+  return given_up_ ? Result<void>(given_up_error()) : r;
 }
 
 Result<void> Task::spawn(std::int64_t now_ns) {
@@ -300,6 +328,8 @@ Result<void> Task::spawn(std::int64_t now_ns) {
   } catch (...) {
     reason = "an exception that is not a std::exception";
   }
+  // Given up while stuck in init: the module and its table stay as they are, the thread's to leave.
+  if (given_up_meanwhile()) return given_up_error();
   if (!reason.empty()) {
     // The paper's rule: an error in init prevents creation and calls kill to free what init took.
     (void)call_raw(Hook::kKill);
@@ -332,6 +362,7 @@ Result<void> Task::turn_on(std::int64_t now_ns) {
   local_->pull_in_consts();
   timing_.release_ns = now_ns;
   const Status s = call(Hook::kOn);
+  if (given_up_) return given_up_error();
   if (s.is_ok()) {
     // Its out-consts are the subsystem's again: another producer of one of them may have
     // published a different value while this task was off (a switch back).
@@ -347,6 +378,7 @@ Result<void> Task::turn_on(std::int64_t now_ns) {
 
 Result<void> Task::turn_off(std::int64_t now_ns) {
   const Status s = call(Hook::kOff);
+  if (given_up_) return given_up_error();
   if (s.is_ok()) {
     set_state(TaskState::kOff);
     return {};
@@ -362,9 +394,11 @@ Result<void> Task::kill(std::int64_t now_ns) {
   std::string problem;
   if (state() == TaskState::kOn) {
     const Status off = call(Hook::kOff);
+    if (given_up_) return given_up_error();
     if (!off.is_ok()) problem = fmt::format("off failed: {}; ", off.reason());
   }
   const Status s = call(Hook::kKill);
+  if (given_up_) return given_up_error();
   if (!s.is_ok()) problem += fmt::format("kill failed: {}", s.reason());
   // A task is destroyed by kill whatever its methods say: its resources are the module's to free.
   destroy_module();
@@ -378,6 +412,7 @@ Result<void> Task::kill(std::int64_t now_ns) {
 
 Result<void> Task::clear(std::int64_t now_ns) {
   const Status s = call(Hook::kClear);
+  if (given_up_) return given_up_error();
   if (!s.is_ok()) {
     shared_->events.push(now_ns, "clear refused; still in ERROR: ", s.reason());
     return make_error(Errc::kModuleFault,
@@ -396,13 +431,13 @@ void Task::lose_process(const char* reason, std::int64_t now_ns) noexcept {
   shared_->events.push(now_ns, "ERROR: ", reason, "; operator intervention required (clear)");
 }
 
-bool Task::give_up_cycle(std::int64_t since_ns, const char* reason, std::int64_t now_ns) noexcept {
+bool Task::give_up(std::int64_t since_ns, const char* reason, std::int64_t now_ns) noexcept {
   std::int64_t stamp = since_ns;
-  // acq_rel: acquire sees what the task's thread did before the cycle began; release pairs with
+  // acq_rel: acquire sees what the task's thread did before the method began; release pairs with
   // its exchange in BusyScope::returned, which then sees the ERROR set below.
   if (!shared_->busy_since_ns.compare_exchange_strong(stamp, TaskShared::kGivenUp, std::memory_order_acq_rel,
                                                       std::memory_order_relaxed))
-    return false;  // that cycle has returned
+    return false;  // that method has returned
   if (state() != TaskState::kError) set_state(TaskState::kError);
   shared_->events.push(now_ns, "ERROR: ", reason, "");
   return true;

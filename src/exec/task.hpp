@@ -38,13 +38,13 @@ namespace chimera {
 /// One cycle as the flight recorder keeps it (docs/flight-recorder.md), stamped with its release
 /// time; or, with kSkipped, releases that did not run.
 struct CycleRecord {
-  static constexpr std::uint64_t kMissed = 1;    // ended after its deadline
-  static constexpr std::uint64_t kOverrun = 2;   // ran longer than its wcet budget
-  static constexpr std::uint64_t kFailed = 4;    // its method failed (the error path ran)
-  static constexpr std::uint64_t kSkipped = 8;   // not a cycle: `latency_ns` releases skipped (late: skip)
-  std::int64_t latency_ns = 0;   // release to start
-  std::int64_t exec_ns = 0;      // execution time, on the clock the statistics use
-  std::int64_t response_ns = 0;  // release to end
+  static constexpr std::uint64_t kMissed = 1;   // ended after its deadline
+  static constexpr std::uint64_t kOverrun = 2;  // ran longer than its wcet budget
+  static constexpr std::uint64_t kFailed = 4;   // its method failed (the error path ran)
+  static constexpr std::uint64_t kSkipped = 8;  // not a cycle: `latency_ns` releases skipped (late: skip)
+  std::int64_t latency_ns = 0;                  // release to start
+  std::int64_t exec_ns = 0;                     // execution time, on the clock the statistics use
+  std::int64_t response_ns = 0;                 // release to end
   std::uint64_t flags = 0;
 };
 static_assert(sizeof(CycleRecord) == 4 * sizeof(std::uint64_t), "the recorder reads a CycleRecord as four words");
@@ -150,13 +150,14 @@ class Task {
   /// write the task's shared state, from the one thread that handles the death. Not real-time safe.
   void lose_process(const char* reason, std::int64_t now_ns) noexcept;
   /// The real executive's stuck-task watch, main process only (docs/processes.md): gives up the
-  /// cycle() this task's thread has been inside since `since_ns` (its heartbeat), if it still is.
-  /// The task is ERROR then (holding the flag) with an event giving `reason`, and its thread,
-  /// whenever the cycle returns, leaves it alone (given_up()). False when that cycle has returned
-  /// meanwhile. The watch's thread; not real-time safe.
-  bool give_up_cycle(std::int64_t since_ns, const char* reason, std::int64_t now_ns) noexcept;
-  /// On the task's thread, after begin_job: its cycle was given up while it ran, and this thread
-  /// must touch neither the task nor its thread-mates again.
+  /// module method this task's thread has been inside since `since_ns` (its heartbeat), if it
+  /// still is: cycle(), a signal's method (init, on, off, kill, clear), reinit, or error() after a
+  /// failed cycle. The task is ERROR then (holding the flag) with an event giving `reason`, and
+  /// its thread, whenever the method returns, leaves it alone (given_up()). False when that
+  /// method has returned meanwhile. The watch's thread; not real-time safe.
+  bool give_up(std::int64_t since_ns, const char* reason, std::int64_t now_ns) noexcept;
+  /// On the task's thread, after a method: it was given up while it ran, and this thread must
+  /// touch neither the task nor its thread-mates again.
   [[nodiscard]] bool given_up() const noexcept { return given_up_; }
   /// The heartbeat as it stands: the method the task's thread is inside and since when (subsystem
   /// clock), if any. Any thread.
@@ -188,6 +189,12 @@ class Task {
   /// failed Status whose reason lives in exception_text_. Real-time safe for the framework.
   Status call(Hook hook) noexcept;
   Status call_raw(Hook hook) noexcept;
+  /// After a module method returned inside method_scope_: whether the stuck-task watch gave the
+  /// task up meanwhile (then given_up(), and nothing of the task is this thread's any more).
+  /// Otherwise the heartbeat goes on under a stamp no give-up aimed at that method can match.
+  bool given_up_meanwhile() noexcept;
+  /// The reply to a signal whose method was given up.
+  [[nodiscard]] Error given_up_error() const;
   Status dispatch(Hook hook) noexcept;
   /// The paper's error rule after `hook` failed with `failure`: error() may recover (true);
   /// otherwise the task enters ERROR (false). Real-time safe.
@@ -224,8 +231,9 @@ class Task {
     std::int64_t start_ns = 0;    // subsystem clock
     std::int64_t exec_start = 0;  // on exec_clock_
   } job_;
-  bool given_up_ = false;            // the task's thread's: see given_up()
-  std::uint64_t timing_faults_ = 0;  // recovered ones too: events are sent at 1, 2, 4, 8...
+  bool given_up_ = false;              // the task's thread's: see given_up()
+  BusyScope* method_scope_ = nullptr;  // the heartbeat of the signal or reinit under way, for call()
+  std::uint64_t timing_faults_ = 0;    // recovered ones too: events are sent at 1, 2, 4, 8...
   std::atomic<std::uint64_t> reinits_{0};
   std::array<char, 160> exception_text_{};
 

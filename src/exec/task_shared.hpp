@@ -28,8 +28,8 @@ const char* busy_in_name(BusyIn method) noexcept;
 struct TaskShared {
   static constexpr std::size_t kEventCapacity = 64;
   static constexpr std::int64_t kIdle = std::numeric_limits<std::int64_t>::min();
-  /// The stamp of a cycle() the stuck-task watch gave up (Task::give_up_cycle): its thread finds
-  /// it when the cycle returns, and from then on leaves the task alone.
+  /// The stamp of a method the stuck-task watch gave up (Task::give_up): its thread finds it when
+  /// the method returns, and from then on leaves the task alone.
   static constexpr std::int64_t kGivenUp = kIdle + 1;
 
   alignas(64) std::atomic<TaskState> state{TaskState::kNotCreated};
@@ -68,8 +68,9 @@ struct StuckBound {
 /// Stamps the heartbeat for the scope of one module method. Real-time safe: a few stores.
 class BusyScope {
  public:
-  BusyScope(TaskShared& shared, BusyIn method, std::int64_t now_ns) noexcept : shared_(shared), since_(now_ns) {
-    shared_.busy_in.store(method, std::memory_order_relaxed);  // published by the release below
+  BusyScope(TaskShared& shared, BusyIn method, std::int64_t now_ns) noexcept
+      : shared_(shared), since_(now_ns), method_(method) {
+    shared_.busy_in.store(method, std::memory_order_relaxed);        // published by the release below
     shared_.busy_since_ns.store(now_ns, std::memory_order_release);  // release: the method is read with it
   }
   ~BusyScope() {
@@ -85,17 +86,23 @@ class BusyScope {
   /// method that returned can match.
   [[nodiscard]] bool returned(std::optional<BusyIn> then = std::nullopt) noexcept {
     open_ = then.has_value();
-    if (then) shared_.busy_in.store(*then, std::memory_order_relaxed);  // published by the exchange below
+    if (then) {
+      method_ = *then;
+      shared_.busy_in.store(*then, std::memory_order_relaxed);  // published by the exchange below
+    }
     // acq_rel: release orders the method (and `then`) before the new stamp; acquire pairs with the
     // watch's give-up, so that this thread sees the ERROR it set before leaving the task alone.
     const std::int64_t was =
         shared_.busy_since_ns.exchange(then ? since_ + 1 : TaskShared::kIdle, std::memory_order_acq_rel);
     return was == TaskShared::kGivenUp;
   }
+  /// The method the stamp names now.
+  [[nodiscard]] BusyIn method() const noexcept { return method_; }
 
  private:
   TaskShared& shared_;
   std::int64_t since_;
+  BusyIn method_;
   bool open_ = true;
 };
 

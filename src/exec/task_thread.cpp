@@ -26,6 +26,7 @@ void TaskThread::main() {
   Worker& w = *members.front();
   for (;;) {
     (void)w.take_mail();
+    if (w.task->given_up()) return;                       // stuck in a signal's method, and given up
     if (exiting.load(std::memory_order_relaxed)) return;  // its own store, in take_mail()
     if (w.task->state() != TaskState::kOn) {
       pollfd p{w.bell_fd, POLLIN, 0};
@@ -44,7 +45,11 @@ void TaskThread::run_periodic_members() {
     // Read the bell before the mail: a mail posted after this read changes the bell, so the
     // wait below cannot miss it.
     const std::uint32_t rung = bell.load(std::memory_order_acquire);  // acquire: pairs with the poster
-    for (Worker* m : members) (void)m->take_mail();
+    for (Worker* m : members) {
+      (void)m->take_mail();
+      // Stuck in a signal's method and given up: the other members run on another thread now.
+      if (m->task->given_up()) return;
+    }
     if (exiting.load(std::memory_order_relaxed)) return;  // its own store, in take_mail()
     std::int64_t earliest = Worker::kNever;
     for (Worker* m : members) earliest = std::min(earliest, m->prepare());

@@ -80,7 +80,7 @@ void ends_with_the_stuck_task_left_behind(End end) {
   EXPECT_NE(out.find("spin "), std::string::npos) << out;
 }
 
-// The watch (stuck_cycles.cpp): spin, stuck in cycle() from its 25th cycle (50 ms in), shares
+// The watch (stuck_methods.cpp): spin, stuck in cycle() from its 25th cycle (50 ms in), shares
 // its thread with load (one CPU and one period under rm). Once it has been inside that cycle ten
 // periods, and at least the floor, it is ERROR and load goes on, on a thread of its own; without
 // the watch load stops with it, after its 25 cycles.
@@ -121,6 +121,55 @@ TEST(StuckTask, AStuckCycleIsGivenUpAndItsThreadMateRunsOn) {
   EXPECT_EQ(doc.at("tasks").at("load").at("state"), "ON");  // the statistics are of the run, before the stop
   // 750 cycles in the last 1.5 s alone; a loaded machine may run fewer, never only the first 25.
   EXPECT_GE(doc.at("tasks").at("load").at("cycles").get<long>(), 300) << run.out();
+  EXPECT_FALSE(std::filesystem::exists("/dev/shm/chimera_" + name)) << "the region was left behind";
+}
+
+// The same for a method a signal runs: `on stuck` never returns from on(). The signal answers
+// after its 10 s that it had no answer; the watch then gives on() up (its bound is the same 10 s):
+// stuck is ERROR, and load, its thread-mate (one CPU and one period), which the stuck thread held
+// from the signal on, goes on on a thread of its own. Without it load never cycles again.
+TEST(StuckTask, AStuckOnIsGivenUpAndItsThreadMateRunsOn) {
+  TempDir dir;
+  const std::string name = "stuck_on_" + std::to_string(::getpid());
+  const std::string file = dir.file(name + ".yaml");
+  test::write_text(file, "subsystem: " + name +
+                             "\n"
+                             "plugins: [" FAULTY_PLUGIN
+                             "]\n"
+                             "tasks:\n"
+                             "  - {name: load, module: cpu_load, period: 2ms, cpu: 0, criticality: soft}\n"
+                             "  - {name: stuck, module: loop_in_on, period: 2ms, cpu: 0, criticality: soft}\n"
+                             "configurations:\n"
+                             "  calm: [load]\n"
+                             "  both: [load, stuck]\n");
+  // on at 300 ms; given up 10 s later; then load runs for 2.5 s more at least.
+  const std::int64_t on_at_ms = 300;
+  const std::int64_t run_ms = on_at_ms + StuckBound::kMethodNs / 1'000'000 + 2'500;
+  const std::string stats = dir.file("stats.json");
+  ChimeraProcess run(dir, {"run", file, "--for", std::to_string(run_ms) + "ms", "--stats-json", stats});
+  std::this_thread::sleep_for(std::chrono::milliseconds(on_at_ms));
+  run.send("spawn stuck\non stuck\n");
+  // Once given up, the task cannot be signalled: clear is refused at once, and says why.
+  std::this_thread::sleep_for(std::chrono::milliseconds(StuckBound::kMethodNs / 1'000'000 + 1'000));
+  run.send("clear stuck\n");
+  const int code = run.wait_exit(kEndsWithinMs + static_cast<int>(run_ms));
+  ASSERT_NE(code, -1) << "the run did not end\n" << run.err();
+  const std::string said = run.out() + run.err();
+  EXPECT_NE(said.find("stuck: no answer within 10.000 s (a method is stuck?)"), std::string::npos) << said;
+  EXPECT_NE(said.find("stuck: stuck in on(), and given up: a task of the main process cannot be stopped or restarted"),
+            std::string::npos)
+      << said;
+  EXPECT_EQ(code, 1) << run.err();  // stuck's thread is left behind at the stop, still in on()
+  const std::string err = run.err();
+  EXPECT_NE(err.find("ERROR: stuck in on() for"), std::string::npos) << err;
+  EXPECT_NE(err.find("given up: its thread drops to SCHED_IDLE, and load moved to a new thread"), std::string::npos)
+      << err;
+  const auto doc = nlohmann::json::parse(test::read_text(stats));
+  EXPECT_EQ(doc.at("tasks").at("stuck").at("state"), "ERROR");
+  EXPECT_EQ(doc.at("tasks").at("load").at("state"), "ON");
+  // 150 cycles before the signal, none for the 10 s it held the thread, then 1,250 in the last
+  // 2.5 s alone; a loaded machine may run fewer, never only the first 150.
+  EXPECT_GE(doc.at("tasks").at("load").at("cycles").get<long>(), 600) << run.out();
   EXPECT_FALSE(std::filesystem::exists("/dev/shm/chimera_" + name)) << "the region was left behind";
 }
 

@@ -1,7 +1,7 @@
 // Modules that end or hang their process the ways a faulty module does (issue 15): a write through
-// a null pointer, abort(), exit(3), and an endless loop in cycle(). Each publishes a counter (so it is a writer of the table like any other)
-// and ends its process at cycle `after`; with `once_file` set, only while that file does not exist
-// (it creates it first), so that a restarted process runs on.
+// a null pointer, abort(), exit(3), and an endless loop in cycle(). Each publishes a counter (so it is a writer of the
+// table like any other) and ends its process at cycle `after`; with `once_file` set, only while that file does not
+// exist (it creates it first), so that a restarted process runs on.
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -89,9 +89,24 @@ class LoopInCycle final : public EndsItsProcess<Fault::kLoop> {
   static constexpr const char* kDoc = "Stays in cycle() forever from cycle `after` on.";
 };
 
+// Stuck in on(): a module whose activation never returns (a wait on hardware that never answers).
+class LoopInOn final : public chimera::Module {
+ public:
+  static constexpr const char* kName = "loop_in_on";
+  static constexpr const char* kSummary = "never returns from on() (a test of the stuck-task watch)";
+  static constexpr const char* kDoc = "Stays in on() forever; cycles do nothing.";
+  static void declare(chimera::Declarations& /*d*/, const chimera::Params& /*params*/) {}
+
+ protected:
+  chimera::Status on() override {
+    for (;;) ::usleep(1000);  // endless, yet it leaves the CPU to the others
+  }
+};
+
 }  // namespace
 
 CHIMERA_REGISTER_MODULE(SegfaultInCycle);
 CHIMERA_REGISTER_MODULE(AbortInCycle);
 CHIMERA_REGISTER_MODULE(ExitInCycle);
 CHIMERA_REGISTER_MODULE(LoopInCycle);
+CHIMERA_REGISTER_MODULE(LoopInOn);
