@@ -19,6 +19,7 @@
 #include "exec/task_block.hpp"
 #include "exec/task_set.hpp"
 #include "flight_recorder.hpp"
+#include "reconfig/request_board.hpp"
 
 namespace chimera {
 
@@ -95,7 +96,10 @@ int run_module_process(const SubsystemSpec& spec, const Registry& registry, cons
     reply(sock, make_error(Errc::kInvalidInput, fmt::format("the file has no task in process {}", args.process)));
     return 1;
   }
-  TaskSet tasks(resolved, *table, nullptr, shared);
+  // Its tasks' switch requests go into the block's slots and ring its bell, where the main
+  // process's service thread serves them as it does its own tasks'.
+  SubsystemRequestBoard requests(spec.configuration_names(), *block);
+  TaskSet tasks(resolved, *table, &requests, shared);
   for (Task* t : tasks.pointers()) t->set_rt_check(args.rt_check);
   // Its tasks record what they write and how they cycle in the rings the main process dumps.
   std::unique_ptr<FlightRecorder> recorder;

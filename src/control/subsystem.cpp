@@ -31,12 +31,6 @@ std::string join_lines(const std::vector<Violation>& violations) {
   return out;
 }
 
-std::vector<std::string> configuration_names(const SubsystemSpec& spec) {
-  std::vector<std::string> names;
-  for (const auto& c : spec.configurations) names.push_back(c.name);
-  return names;
-}
-
 }  // namespace
 
 Result<void> check_task_cpus(const SubsystemSpec& spec) {
@@ -103,7 +97,6 @@ Result<void> Subsystem::Impl::build_runtime(const std::string& configuration, st
   }
 
   const ResolvedSubsystem& resolved = m.resolution.subsystem;
-  m.requests = std::make_unique<SubsystemRequestBoard>(configuration_names(m.spec), resolved.tasks.size());
   // Module processes run on the real clock only: the virtual clock simulates every task on one thread.
   std::vector<TaskShared*> shared;
   if (m.options.clock == ClockKind::kReal && m.spec.uses_module_processes()) {
@@ -118,6 +111,9 @@ Result<void> Subsystem::Impl::build_runtime(const std::string& configuration, st
     for (std::size_t i = 0; i < resolved.tasks.size(); ++i)
       shared.push_back(m.spec.tasks[i].process == kMainProcess ? nullptr : m.block->slot(i));
   }
+  // With module processes the requests' slots and bell are the block's, where their tasks ask too.
+  m.requests = m.block ? std::make_unique<SubsystemRequestBoard>(m.spec.configuration_names(), *m.block)
+                       : std::make_unique<SubsystemRequestBoard>(m.spec.configuration_names(), resolved.tasks.size());
   m.tasks = std::make_unique<TaskSet>(resolved, *m.table, m.requests.get(), shared);
   m.events = std::make_unique<EventLog>(m.tasks->size());
   {

@@ -102,8 +102,8 @@ Result<void> Subsystem::Impl::rebuild_runtime(SubsystemSpec next, const std::str
   m.executive.reset();
   m.events.reset();
   m.tasks.reset();
+  m.requests.reset();  // its slots may be the block's
   m.block.reset();
-  m.requests.reset();
   m.table.reset();  // the region's name is free again for the new table
   m.spec = std::move(next);
   Result<void> outcome = m.build_runtime(configuration, now);

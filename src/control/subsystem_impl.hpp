@@ -32,8 +32,8 @@ struct Subsystem::Impl {
   const Registry* registry = nullptr;  // for the live assembly's re-resolution; outlives the subsystem
   Resolution resolution;
   std::unique_ptr<GlobalTable> table;
-  std::unique_ptr<SubsystemRequestBoard> requests;
   std::unique_ptr<TaskBlock> block;  // module processes' tasks' shared slots (docs/processes.md); null: none
+  std::unique_ptr<SubsystemRequestBoard> requests;  // in the block's slots when there is one: declared after it
   std::unique_ptr<TaskSet> tasks;
   std::unique_ptr<FlightRecorder> recorder;   // the tasks write into it; null: none kept
   std::vector<std::uint64_t> dumped_failure;  // per task, the failure its ERROR dump was for; run_for's thread only

@@ -1,7 +1,9 @@
 #pragma once
 // A word that changes each time someone has news, and that a thread can sleep on until it does
 // (a Linux futex underneath): how a module's switch request reaches the subsystem interface, and
-// how the real executive's service thread waits for it. Ringing is real-time safe.
+// how the real executive's service thread waits for it. Ringing is real-time safe. Process-shared:
+// it holds no pointer and may live in shared memory (the task block), where a module process's
+// task rings the bell the main process's service thread sleeps on.
 
 #include <atomic>
 #include <cstdint>

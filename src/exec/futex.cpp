@@ -20,15 +20,17 @@ long futex(const std::atomic<std::uint32_t>& word, int op, std::uint32_t value, 
 }
 }  // namespace
 
-bool futex_wait(const std::atomic<std::uint32_t>& word, std::uint32_t expected, std::int64_t deadline_ns) noexcept {
+bool futex_wait(const std::atomic<std::uint32_t>& word, std::uint32_t expected, std::int64_t deadline_ns,
+                FutexScope scope) noexcept {
   // FUTEX_WAIT_BITSET takes an absolute CLOCK_MONOTONIC time, so no drift from relative waits.
   const timespec ts = to_timespec(deadline_ns < 0 ? 0 : deadline_ns);
-  const long r = futex(word, FUTEX_WAIT_BITSET | FUTEX_PRIVATE_FLAG, expected, deadline_ns < 0 ? nullptr : &ts);
+  const int op = FUTEX_WAIT_BITSET | (scope == FutexScope::kProcess ? FUTEX_PRIVATE_FLAG : 0);
+  const long r = futex(word, op, expected, deadline_ns < 0 ? nullptr : &ts);
   return !(r == -1 && errno == ETIMEDOUT);
 }
 
-void futex_wake_all(const std::atomic<std::uint32_t>& word) noexcept {
-  (void)futex(word, FUTEX_WAKE_BITSET | FUTEX_PRIVATE_FLAG, INT_MAX, nullptr);
+void futex_wake_all(const std::atomic<std::uint32_t>& word, FutexScope scope) noexcept {
+  (void)futex(word, FUTEX_WAKE_BITSET | (scope == FutexScope::kProcess ? FUTEX_PRIVATE_FLAG : 0), INT_MAX, nullptr);
 }
 
 }  // namespace chimera::detail

@@ -9,10 +9,15 @@ namespace chimera::detail {
 
 static_assert(sizeof(std::atomic<std::uint32_t>) == sizeof(std::uint32_t), "futex needs a plain 32-bit word");
 
+/// Whether sleepers and wakers may be in different processes, the word in shared memory. A word
+/// private to one process takes the kernel's cheaper path; both sides must say the same.
+enum class FutexScope : std::uint8_t { kProcess, kShared };
+
 /// Sleeps while `word` holds `expected`, until woken or until the absolute CLOCK_MONOTONIC time
 /// `deadline_ns` (< 0: no deadline). Returns false on timeout. Spurious returns are possible.
-bool futex_wait(const std::atomic<std::uint32_t>& word, std::uint32_t expected, std::int64_t deadline_ns) noexcept;
+bool futex_wait(const std::atomic<std::uint32_t>& word, std::uint32_t expected, std::int64_t deadline_ns,
+                FutexScope scope = FutexScope::kProcess) noexcept;
 /// Wakes every thread sleeping on `word`.
-void futex_wake_all(const std::atomic<std::uint32_t>& word) noexcept;
+void futex_wake_all(const std::atomic<std::uint32_t>& word, FutexScope scope = FutexScope::kProcess) noexcept;
 
 }  // namespace chimera::detail

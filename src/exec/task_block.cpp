@@ -29,19 +29,21 @@ struct alignas(64) Header {
   std::uint64_t layout = kLayout;
   std::uint64_t tasks = 0;
   std::atomic<std::int64_t> epoch_ns{0};
+  Doorbell requests;
   // A robust mutex's list links point into its owner's memory: only the owner and the kernel
   // read them, never another process, so the rule that shared memory holds no pointer stands.
   std::array<pthread_mutex_t, ProcessCommand::kMaxTasks> life;
 };
 static_assert(std::atomic<std::int64_t>::is_always_lock_free);
 
-constexpr std::size_t kSlotsOffset = (sizeof(Header) + alignof(TaskShared) - 1) / alignof(TaskShared) * alignof(TaskShared);
+constexpr std::size_t kSlotsOffset =
+    (sizeof(Header) + alignof(TaskShared) - 1) / alignof(TaskShared) * alignof(TaskShared);
 
 std::size_t block_bytes(std::size_t tasks) { return kSlotsOffset + tasks * sizeof(TaskShared); }
 
 Error sys_error(std::string_view what) {
-  return make_error(Errc::kSystem, fmt::format("the task block: {} failed: {}", what,
-                                               std::generic_category().message(errno)));
+  return make_error(Errc::kSystem,
+                    fmt::format("the task block: {} failed: {}", what, std::generic_category().message(errno)));
 }
 
 }  // namespace
@@ -129,6 +131,8 @@ TaskShared* TaskBlock::slot(std::size_t task) const noexcept {
 pthread_mutex_t* TaskBlock::life(std::size_t process) const noexcept {
   return &std::launder(reinterpret_cast<Header*>(base_))->life[process];
 }
+
+Doorbell& TaskBlock::requests_bell() const noexcept { return std::launder(reinterpret_cast<Header*>(base_))->requests; }
 
 std::int64_t TaskBlock::epoch_ns() const noexcept {
   // Acquire: pairs with set_epoch_ns, written before any worker starts.

@@ -13,6 +13,7 @@
 #include <cstdint>
 
 #include "chimera/core/result.hpp"
+#include "doorbell.hpp"
 #include "task_shared.hpp"
 
 namespace chimera {
@@ -43,6 +44,9 @@ class TaskBlock {
   /// it as the worker's threads exit, before it frees the worker's memory, so a waiter in the
   /// main process learns of the death long before the pidfd does. One per possible process.
   [[nodiscard]] pthread_mutex_t* life(std::size_t process) const noexcept;
+  /// The bell of the subsystem's switch requests (the slots are TaskShared::switch_request): a
+  /// module process's task rings it, the main process's service thread sleeps on it.
+  [[nodiscard]] Doorbell& requests_bell() const noexcept;
 
  private:
   TaskBlock() = default;

@@ -39,6 +39,10 @@ struct TaskShared {
   /// process whose task stays too long in one; the main process's own stuck cycles are given up.
   std::atomic<std::int64_t> busy_since_ns{kIdle};
   std::atomic<BusyIn> busy_in{BusyIn::kCycle};
+  /// The configuration the task's module asks for (index in the file, -1: none), where the file
+  /// has module processes: the request board's slot (reconfig/request_board.hpp), shared so that a
+  /// module process's task can ask. Written by the task's thread, cleared by the service thread.
+  std::atomic<int> switch_request{-1};
   TaskStats stats;
   EventRing<kEventCapacity> events;
 };

@@ -74,7 +74,12 @@ TEST(NoAllocationInModuleProcess, Figure4InAWorkerOnTheRealClock) {
   auto owner = Subsystem::create(*spec, Registry::global(), options);
   ASSERT_TRUE(owner.ok()) << owner.error().message;
   SubsystemSpec in_worker = *spec;
-  for (auto& t : in_worker.tasks) t.process = "arm";
+  // Soft: a deadline a loaded machine makes them miss must not end their cycling (ERROR); the
+  // subject here is allocation, not timing.
+  for (auto& t : in_worker.tasks) {
+    t.process = "arm";
+    t.criticality = Criticality::kSoft;
+  }
   const std::size_t n = in_worker.tasks.size();
 
   auto block = TaskBlock::create(n);

@@ -166,6 +166,12 @@ struct SubsystemSpec {
       if (c.name == config_name) return &c;
     return nullptr;
   }
+  /// The configurations' names in file order: what a module's switch request names by index.
+  [[nodiscard]] std::vector<std::string> configuration_names() const {
+    std::vector<std::string> names;
+    for (const auto& c : configurations) names.push_back(c.name);
+    return names;
+  }
 };
 
 }  // namespace chimera

@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "chimera/config/loader.hpp"
+#include "chimera/config/plugins.hpp"
 #include "chimera/control/subsystem.hpp"
 #include "chimera/module/registry.hpp"
 #include "run_chimera.hpp"
@@ -83,6 +84,54 @@ TEST(ProcessSwitch, BackAndForthBetweenTheMainProcessAndAModuleProcess) {
         << "round " << round << ": the leaving generator ran on after the switch";
   }
   EXPECT_EQ(s.configuration(), "here");
+  for (const auto& t : s.snapshot()) EXPECT_NE(t.state, TaskState::kError) << t.name << ": " << t.last_error;
+  s.stop();
+}
+
+// A module in a module process asks for switches as one in the main process does: its request
+// reaches the main process's service thread through the task block, which switches. Two askers
+// in the planner process take turns: each, once on, asks for the other's configuration.
+TEST(ProcessSwitch, AModuleInAModuleProcessAsksForSwitches) {
+  TempDir dir;
+  const std::string path = dir.file("asked_switch.yaml");
+  test::write_text(path,
+                   "subsystem: asked_switch\n"
+                   "plugins: [" FAULTY_PLUGIN
+                   "]\n"
+                   "tasks:\n"
+                   "  - {name: traj, module: joint_traj_gen, period: 2ms, criticality: soft}\n"
+                   "  - {name: pid, module: pid_joint, period: 2ms, criticality: soft}\n"
+                   "  - {name: robot, module: robot_torque, period: 2ms, criticality: soft}\n"
+                   "  - {name: to_second, module: asks_for_switch, period: 2ms, criticality: soft, process: planner,"
+                   " params: {to: second, after: 20}}\n"
+                   "  - {name: to_first, module: asks_for_switch, period: 2ms, criticality: soft, process: planner,"
+                   " params: {to: first, after: 20}}\n"
+                   "configurations:\n"
+                   "  first: [traj, pid, robot, to_second]\n"
+                   "  second: [traj, pid, robot, to_first]\n"
+                   "requests:\n"
+                   "  - {from: first, to: second, by: to_second}\n"
+                   "  - {from: second, to: first, by: to_first}\n");
+  auto plugins = load_file_plugins(path);
+  ASSERT_TRUE(plugins.ok()) << plugins.error().message;
+  auto spec = load_subsystem_file(path, Registry::global());
+  ASSERT_TRUE(spec.ok()) << spec.error().message;
+  RunOptions options;
+  options.realtime_priorities = false;
+  options.shm_suffix = "_" + std::to_string(::getpid());
+  options.worker_program = CHIMERA_BIN;
+  auto made = Subsystem::create(*spec, Registry::global(), options);
+  ASSERT_TRUE(made.ok()) << made.error().message;
+  Subsystem& s = **made;
+  ASSERT_TRUE(s.start().ok());
+  for (int i = 0; i < kMaxSteps && s.switches().size() < 4; ++i) s.run_for(kStepNs);
+  const auto switches = s.switches();
+  ASSERT_GE(switches.size(), 4U) << "the askers' requests did not reach the main process";
+  for (std::size_t i = 0; i < 4; ++i) {
+    const bool to_second = i % 2 == 0;
+    EXPECT_EQ(switches[i].to, to_second ? "second" : "first") << i;
+    EXPECT_EQ(switches[i].cause, to_second ? "requested by to_second" : "requested by to_first") << i;
+  }
   for (const auto& t : s.snapshot()) EXPECT_NE(t.state, TaskState::kError) << t.name << ": " << t.last_error;
   s.stop();
 }

@@ -1,5 +1,6 @@
 // Modules that end or hang their process the ways a faulty module does (issue 15): a write through
-// a null pointer, abort(), exit(3), and an endless loop in cycle(). Each publishes a counter (so it is a writer of the
+// a null pointer, abort(), exit(3), and an endless loop in cycle() or on(); and one that asks for
+// switches, to be run in a module process. Each publishes a counter (so it is a writer of the
 // table like any other) and ends its process at cycle `after`; with `once_file` set, only while that file does not
 // exist (it creates it first), so that a restarted process runs on.
 
@@ -103,6 +104,40 @@ class LoopInOn final : public chimera::Module {
   }
 };
 
+// Not faulty: asks for a switch to `to` from its cycle `after` on, every cycle (asking again
+// while the request is pending costs nothing); a module process's way of reaching the subsystem
+// interface, as a singularity monitor's.
+class AsksForSwitch final : public chimera::Module {
+ public:
+  static constexpr const char* kName = "asks_for_switch";
+  static constexpr const char* kSummary = "asks for a switch after some cycles (a test of module processes)";
+  static constexpr const char* kDoc = "Asks for configuration `to` from cycle `after` on.";
+  static void declare(chimera::Declarations& d, const chimera::Params& /*params*/) {
+    d.param("to", std::string(), "", "the configuration to ask for");
+    d.param("after", 10.0, "", "the cycle from which it asks");
+  }
+
+ protected:
+  chimera::Status init(chimera::InitContext& ctx) override {
+    to_ = ctx.switch_request(ctx.params().text("to", ""));
+    after_ = static_cast<long>(ctx.params().number("after", 10.0));
+    return chimera::Status::ok();
+  }
+  chimera::Status on() override {
+    cycles_ = 0;  // counts from each turning on
+    return chimera::Status::ok();
+  }
+  chimera::Status cycle() override {
+    if (++cycles_ >= after_) to_.ask();
+    return chimera::Status::ok();
+  }
+
+ private:
+  chimera::SwitchRequest to_;
+  long after_ = 10;
+  long cycles_ = 0;
+};
+
 }  // namespace
 
 CHIMERA_REGISTER_MODULE(SegfaultInCycle);
@@ -110,3 +145,4 @@ CHIMERA_REGISTER_MODULE(AbortInCycle);
 CHIMERA_REGISTER_MODULE(ExitInCycle);
 CHIMERA_REGISTER_MODULE(LoopInCycle);
 CHIMERA_REGISTER_MODULE(LoopInOn);
+CHIMERA_REGISTER_MODULE(AsksForSwitch);
