@@ -1,9 +1,11 @@
 // chimera __worker --file FILE --process NAME --table NAME --socket-fd N --block-fd N --life N [--config NAME]
-// [--no-realtime] [--cpu-time] [--rt-check] [--history-fd N --record-seconds S]: a module process (docs/processes.md).
-// Not for people: the main process of `chimera run` starts it, and it is left out of the help.
+// [--no-realtime] [--cpu-time] [--rt-check] [--history-fd N --record-seconds S] [--bell TASK:FD ...]: a module process
+// (docs/processes.md). Not for people: the main process of `chimera run` starts it, and it is left out of the help.
 
+#include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -28,6 +30,8 @@ int worker_command(int argc, char** argv) {
   app.add_option("--block-fd", args.block_fd)->required();
   app.add_option("--life", args.life)->required();
   app.add_option("--history-fd", args.history_fd);
+  std::vector<std::string> bells;  // TASK:FD, one an aperiodic task
+  app.add_option("--bell", bells);
   std::string record_seconds =
       "0";  // read with strtod, as fmt wrote it: exactly that double (CLI11 goes through long double)
   app.add_option("--record-seconds", record_seconds);
@@ -42,6 +46,13 @@ int worker_command(int argc, char** argv) {
   }
   args.realtime_priorities = !no_realtime;
   args.record_seconds = std::strtod(record_seconds.c_str(), nullptr);
+  for (const std::string& bell : bells) {
+    unsigned long task = 0;
+    int fd = -1;
+    if (std::sscanf(bell.c_str(), "%lu:%d", &task, &fd) != 2)
+      return kExitInvalid;  // NOLINT(cert-err34-c): both checked by the count
+    args.bells.emplace_back(task, fd);
+  }
   if (config_opt->count() > 0) args.configuration = config;
   // The same file and plugins as the main process: the tasks' indices are the same.
   auto spec = load_file(file, args.configuration);

@@ -84,13 +84,13 @@ int run_module_process(const SubsystemSpec& spec, const Registry& registry, cons
     reply(sock, block.error());
     return 1;
   }
-  // Its own tasks keep what the main process must see in the block; the others are never spawned here.
+  // Every task's shared part is the block's, as in the main process: its own tasks keep there what
+  // the main process must see, and the others (never spawned here) what its producers wake them by.
   std::vector<TaskShared*> shared(resolved.tasks.size(), nullptr);
   std::vector<bool> mine(resolved.tasks.size(), false);
   for (std::size_t i = 0; i < resolved.tasks.size(); ++i) {
-    if (resolved.tasks[i].spec->process != args.process) continue;
     shared[i] = block->slot(i);
-    mine[i] = true;
+    mine[i] = resolved.tasks[i].spec->process == args.process;
   }
   if (std::find(mine.begin(), mine.end(), true) == mine.end()) {
     reply(sock, make_error(Errc::kInvalidInput, fmt::format("the file has no task in process {}", args.process)));
@@ -124,6 +124,9 @@ int run_module_process(const SubsystemSpec& spec, const Registry& registry, cons
   setup.events = &events;
   setup.hosted = mine;
   setup.epoch_ns = block->epoch_ns();
+  setup.bell_fds.assign(resolved.tasks.size(), -1);
+  for (const auto& [task, fd] : args.bells)
+    if (task < resolved.tasks.size()) setup.bell_fds[task] = fd;
   std::unique_ptr<Executive> executive = make_executive(std::move(setup));
   // Held until this process ends, however it ends: the kernel hands it to the main process's
   // watcher as this thread exits, long before the pidfd says the process is gone.

@@ -108,8 +108,9 @@ Result<void> Subsystem::Impl::build_runtime(const std::string& configuration, st
     auto made = TaskBlock::create(resolved.tasks.size());
     if (!made) return made.error();
     m.block = std::make_unique<TaskBlock>(std::move(*made));
-    for (std::size_t i = 0; i < resolved.tasks.size(); ++i)
-      shared.push_back(m.spec.tasks[i].process == kMainProcess ? nullptr : m.block->slot(i));
+    // Every task's shared part in the block, the main process's tasks' too: a producer in a module
+    // process wakes an aperiodic task of the main process through it (TaskShared::wake).
+    for (std::size_t i = 0; i < resolved.tasks.size(); ++i) shared.push_back(m.block->slot(i));
   }
   // With module processes the requests' slots and bell are the block's, where their tasks ask too.
   m.requests = m.block ? std::make_unique<SubsystemRequestBoard>(m.spec.configuration_names(), *m.block)

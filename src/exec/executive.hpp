@@ -63,6 +63,10 @@ struct ExecutiveSetup {
   std::int64_t epoch_ns = 0;
   /// Real clock, a file with module processes: how to start them (process_executive.hpp).
   ProcessSetup processes;
+  /// Real clock: per task, an eventfd to wake it by (an aperiodic task's bell) that the executive
+  /// takes over instead of making its own; -1 or missing: its own. A module process is given the
+  /// main process's, so that a producer in any process wakes an aperiodic task in any other.
+  std::vector<int> bell_fds;
 };
 
 /// A switch's commit (docs/reconfiguration.md).

@@ -80,6 +80,7 @@ Result<void> ModuleProcess::start(const WorkerLaunch& launch) {
   args.insert(args.end(), {"--process", name_, "--socket-fd", std::to_string(pair[1]), "--block-fd",
                            std::to_string(launch.block_fd), "--life", std::to_string(index_)});
   if (launch.history_fd >= 0) args.insert(args.end(), {"--history-fd", std::to_string(launch.history_fd)});
+  for (const auto& [task, fd] : launch.bells) args.insert(args.end(), {"--bell", fmt::format("{}:{}", task, fd)});
   std::vector<char*> argv;
   argv.reserve(args.size() + 1);
   for (auto& a : args) argv.push_back(a.data());
@@ -97,6 +98,7 @@ Result<void> ModuleProcess::start(const WorkerLaunch& launch) {
     ::fcntl(pair[1], F_SETFD, 0);
     ::fcntl(launch.block_fd, F_SETFD, 0);
     if (launch.history_fd >= 0) ::fcntl(launch.history_fd, F_SETFD, 0);
+    for (const auto& bell : launch.bells) ::fcntl(bell.second, F_SETFD, 0);
     ::setpgid(0, 0);
     sigset_t none;
     ::sigemptyset(&none);

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <mutex>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "chimera/core/result.hpp"
@@ -23,6 +24,7 @@ struct WorkerLaunch {
   std::vector<std::string> args;  // after the worker mode's name; --process, --socket-fd follow
   int block_fd = -1;              // the task block's memfd, inherited at this number
   int history_fd = -1;            // the flight recorder's rings (a memfd), inherited likewise; -1: none
+  std::vector<std::pair<std::size_t, int>> bells;  // aperiodic tasks' eventfds (task, fd), inherited likewise
 };
 
 class ModuleProcess {

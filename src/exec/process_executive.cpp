@@ -70,6 +70,9 @@ ProcessExecutive::ProcessExecutive(ExecutiveSetup setup)
   local_ = std::make_unique<RealExecutive>(std::move(setup));
   // Before any worker starts: they take this epoch, so that every release is on one grid.
   block_->set_epoch_ns(local_->epoch_ns());
+  // And every aperiodic task's bell, so that its producers in any process can wake it.
+  for (std::size_t i = 0; i < tasks_.size(); ++i)
+    if (const int fd = local_->bell_fd(i); fd >= 0) launch_.bells.emplace_back(i, fd);
   wake_fd_ = ::eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK);
   if (wake_fd_ < 0) spdlog::error("no eventfd for the process supervisor: a module process's end is seen late");
   supervisor_ = std::thread([this] { supervise(); });

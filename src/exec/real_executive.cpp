@@ -126,7 +126,7 @@ RealExecutive::RealExecutive(ExecutiveSetup setup)
     t->set_virtual_clock(false);
     if (setup.measure_cpu_time || t->spec().wcet_ns) t->set_exec_clock(Task::ExecClock::kCpu);
   }
-  make_workers(plan_);
+  make_workers(plan_, setup.bell_fds);
   link_workers();
   if (!is_fixed_priority(plan_.policy)) make_dispatchers(plan_);
   form_threads();
@@ -134,7 +134,7 @@ RealExecutive::RealExecutive(ExecutiveSetup setup)
   overdue_hold_.assign(tasks_.size(), false);
 }
 
-void RealExecutive::make_workers(const SchedulePlan& plan) {
+void RealExecutive::make_workers(const SchedulePlan& plan, const std::vector<int>& bell_fds) {
   const std::vector<Task*>& tasks = tasks_;
   const std::vector<int> priorities = fixed_priorities(plan);
   for (std::size_t i = 0; i < tasks.size(); ++i) {
@@ -144,8 +144,11 @@ void RealExecutive::make_workers(const SchedulePlan& plan) {
     w->index = i;
     w->cpu = plan.cpu[i];
     w->fixed_priority = priorities[i];
+    w->precedence = &tasks[i]->precedence();
+    // With module processes a successor may sleep on it from another process (link_workers).
+    if (!hosted_.empty()) w->futex_scope = detail::FutexScope::kShared;
     if (!tasks[i]->periodic()) {
-      w->bell_fd = ::eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK);
+      w->bell_fd = i < bell_fds.size() && bell_fds[i] >= 0 ? bell_fds[i] : ::eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK);
       if (w->bell_fd < 0)
         spdlog::error("{}: no eventfd ({}): the task will not wake for events", tasks[i]->name(),
                       std::generic_category().message(errno));
@@ -166,14 +169,15 @@ void RealExecutive::link_workers() {
       return v && std::ranges::find(i.out_vars, static_cast<int>(*v)) != i.out_vars.end();
     });
   };
-  // Only tasks of one process wait for or wake each other: a task of another process has a
-  // Worker here that never runs (docs/processes.md).
+  // A task of another process has a Worker here that never runs (docs/processes.md), whose task's
+  // precedence, trigger state and bell are the ones its own process uses: in the task block, and
+  // an eventfd every process has. So this process's tasks wait for their same-rate producers and
+  // wake their aperiodic consumers in any process.
   for (std::size_t i = 0; i < workers_.size(); ++i) {
     for (const int p : order.predecessors[i])
-      if (hosts(i) && hosts(static_cast<std::size_t>(p)))
-        workers_[i]->predecessors.push_back(workers_[static_cast<std::size_t>(p)].get());
+      if (hosts(i)) workers_[i]->predecessors.push_back(workers_[static_cast<std::size_t>(p)].get());
     for (std::size_t j = 0; j < workers_.size(); ++j)
-      if (j != i && hosts(i) && hosts(j) && !workers_[j]->task->periodic() && reads_from(*workers_[j], *workers_[i]))
+      if (j != i && hosts(i) && !workers_[j]->task->periodic() && reads_from(*workers_[j], *workers_[i]))
         workers_[i]->subscribers.push_back(workers_[j].get());
   }
 }
@@ -294,11 +298,10 @@ void RealExecutive::run_for(std::int64_t ns) {
 
 int RealExecutive::fixed_priority(std::size_t index) const { return workers_[index]->fixed_priority; }
 
+int RealExecutive::bell_fd(std::size_t index) const { return workers_[index]->bell_fd; }
+
 std::optional<std::int64_t> RealExecutive::running_deadline(std::size_t index) const noexcept {
-  // Relaxed: a status word on its own (run_job); the watch only compares it with the clock.
-  const std::int64_t deadline = workers_[index]->running_deadline_ns.load(std::memory_order_relaxed);
-  if (deadline == Worker::kNever) return std::nullopt;
-  return deadline;
+  return tasks_[index]->running_deadline();  // a module process's task keeps it in the task block
 }
 
 namespace {
@@ -458,7 +461,7 @@ Result<void> RealExecutive::turn_on_together(const std::vector<std::size_t>& ind
     Worker& w = *workers_[i];
     if (!w.task->periodic() || w.task->state() != TaskState::kOn) continue;
     const std::int64_t k = release_policy::first_release_index(instant, w.task->period_ns());
-    w.precedence.scheduled.store(k, std::memory_order_release);  // release: pairs with successors' acquire load
+    w.precedence->scheduled.store(k, std::memory_order_release);  // release: pairs with successors' acquire load
     joining.push_back(i);
     joins.push_back(Mail{MailKind::kJoin, Signal::kOn, k});
   }
@@ -517,7 +520,7 @@ CommitOutcome RealExecutive::commit_switch(const SwitchCommit& commit) {
       }
       if (auto on = post_all(joining, join); outcome.fault && !on) outcome.fault = on;
       for (const std::size_t i : joining)
-        workers_[i]->precedence.joining_k.store(-1, std::memory_order_release);  // scheduled says it now
+        workers_[i]->precedence->joining_k.store(-1, std::memory_order_release);  // scheduled says it now
     }
   }
   if (join_part) set_plan(make_schedule_plan(subsystem_, order_, subsystem_cpus(*subsystem_.spec), commit.target));
@@ -528,13 +531,13 @@ void RealExecutive::publish_joins(const std::vector<std::size_t>& joining, std::
   for (const std::size_t i : joining) {
     Worker& w = *workers_[i];
     if (!w.task->periodic()) continue;
-    w.precedence.joining_k.store(release_policy::first_release_index(from_ns, w.task->period_ns()),
-                                 std::memory_order_release);  // release: pairs with successors' acquire
+    w.precedence->joining_k.store(release_policy::first_release_index(from_ns, w.task->period_ns()),
+                                  std::memory_order_release);  // release: pairs with successors' acquire
     // A successor asleep on it for a release it no longer joins at must look again, not sleep to
     // its bound: the leaving producer ran that release. (One just going to sleep may still sleep
     // to its bound: a bounded wait, and only when a commit was posted late.)
-    if (w.precedence.waiters.load(std::memory_order_seq_cst) != 0)  // seq_cst: as in Worker::act
-      detail::futex_wake_all(w.precedence.completed);
+    if (w.precedence->waiters.load(std::memory_order_seq_cst) != 0)  // seq_cst: as in Worker::act
+      detail::futex_wake_all(w.precedence->completed, w.futex_scope);
   }
 }
 
@@ -557,9 +560,10 @@ Result<void> RealExecutive::reinit(std::size_t index) {
 
 void RealExecutive::variable_written(VarIndex v) {
   for (auto& w : workers_) {
-    if (w->wake.trigger_var.load(std::memory_order_relaxed) != static_cast<int>(v)) continue;  // a hint, see below
+    TaskWake& wake = w->task->wake();
+    if (wake.trigger_var.load(std::memory_order_relaxed) != static_cast<int>(v)) continue;  // a hint, see below
     // acq_rel: the value written happens before the cycle that clears the flag
-    if (!w->wake.update_pending.exchange(true, std::memory_order_acq_rel)) ring_bell(*w);
+    if (!wake.update_pending.exchange(true, std::memory_order_acq_rel)) ring_bell(*w);
   }
 }
 

@@ -64,6 +64,9 @@ class RealExecutive final : public Executive {
   [[nodiscard]] const GlobalTable& table() const { return *table_; }
   /// The SCHED_FIFO priority task `index` starts at (its fixed priority under rm and dm).
   [[nodiscard]] int fixed_priority(std::size_t index) const;
+  /// Aperiodic task `index`'s bell (an eventfd), -1 for a periodic task: what a module process is
+  /// given to wake it by (ExecutiveSetup::bell_fds). Any thread.
+  [[nodiscard]] int bell_fd(std::size_t index) const;
   /// Whether this process runs task `index` (ExecutiveSetup::hosted). Any thread.
   [[nodiscard]] bool hosts(std::size_t index) const noexcept { return hosted_.empty() || hosted_[index]; }
   /// The absolute deadline (executive clock) of the job task `index` is running now, if it is
@@ -74,7 +77,7 @@ class RealExecutive final : public Executive {
   static constexpr std::int64_t kWatchTickNs = 5'000'000;
 
  private:
-  void make_workers(const SchedulePlan& plan);
+  void make_workers(const SchedulePlan& plan, const std::vector<int>& bell_fds);
   void link_workers();
   void make_dispatchers(const SchedulePlan& plan);
   void form_threads();

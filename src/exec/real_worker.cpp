@@ -113,7 +113,7 @@ bool Worker::handle(std::uint32_t seq) {
   const std::int64_t join = task->periodic() ? release_policy::first_release_index(now, task->period_ns()) : -1;
   const bool turning_on = before != TaskState::kOn && request == Signal::kOn;
   if (turning_on && task->periodic() && mail.kind == MailKind::kSignal)
-    precedence.scheduled.store(join, std::memory_order_release);  // release: pairs with successors' acquire load
+    precedence->scheduled.store(join, std::memory_order_release);  // release: pairs with successors' acquire load
   mailbox.reply = task->apply(request, now);
   // Given up while stuck in the method: the signal stopped waiting long ago (answering() refuses
   // the task now), and the thread-mates are another thread's. Nothing here is ours to change.
@@ -136,7 +136,7 @@ bool Worker::handle(std::uint32_t seq) {
 
 void Worker::join_now() {
   const std::uint32_t seq = schedule.on_seq;
-  precedence.scheduled.store(schedule.on_at, std::memory_order_release);  // release: successors wait for it
+  precedence->scheduled.store(schedule.on_at, std::memory_order_release);  // release: successors wait for it
   mailbox.reply = task->apply(Signal::kOn, exec->now_ns());
   if (task->state() == TaskState::kOn) {
     schedule.k = schedule.on_at;
@@ -161,8 +161,8 @@ void Worker::leave() {
 
 void Worker::on_turned_on() noexcept {
   schedule.last_run = -1;
-  wake.trigger_var.store(task->trigger_var(), std::memory_order_relaxed);  // producers read it on its own
-  wake.update_pending.store(false, std::memory_order_relaxed);
+  task->wake().trigger_var.store(task->trigger_var(), std::memory_order_relaxed);  // producers read it on its own
+  task->wake().update_pending.store(false, std::memory_order_relaxed);
   if (task->spec().server) server.turn_on(task->spec().server->budget_ns);
 }
 
@@ -177,22 +177,21 @@ void Worker::publish_job(std::int64_t release_abs) {
 std::int64_t Worker::run_job(std::int64_t release_abs) {
   const std::int64_t epoch = exec->epoch_ns();
   const std::int64_t start = monotonic_ns();
-  // Relaxed: a status word, read on its own by the overrun watch; nothing is published with it.
-  running_deadline_ns.store(task->absolute_deadline(release_abs - epoch), std::memory_order_relaxed);
+  task->set_running_deadline(task->absolute_deadline(release_abs - epoch));  // for the overrun watch
   (void)task->begin_job(release_abs - epoch, start - epoch);
   if (task->given_up()) {  // stuck, and given up while it was: nothing more of it is ours
-    running_deadline_ns.store(kNever, std::memory_order_relaxed);  // relaxed: as above
+    task->set_running_deadline(TaskShared::kNoJob);
     return 0;
   }
   const std::int64_t used = task->end_job(monotonic_ns() - epoch, -1);
-  running_deadline_ns.store(kNever, std::memory_order_relaxed);  // relaxed: as above
+  task->set_running_deadline(TaskShared::kNoJob);
   for (const int v : out_vars)
     if (WriteWatch* watch = exec->watch_of(v); watch != nullptr) watch->written();  // the DDS bridge's exports
   for (Worker* s : subscribers) {
-    const int v = s->wake.trigger_var.load(std::memory_order_relaxed);  // a hint; the flag below orders
+    const int v = s->task->wake().trigger_var.load(std::memory_order_relaxed);  // a hint; the flag below orders
     if (v < 0 || std::find(out_vars.begin(), out_vars.end(), v) == out_vars.end()) continue;
     // acq_rel: our published values happen before the subscriber's cycle that clears the flag
-    if (!s->wake.update_pending.exchange(true, std::memory_order_acq_rel)) ring_bell(*s);
+    if (!s->task->wake().update_pending.exchange(true, std::memory_order_acq_rel)) ring_bell(*s);
   }
   if (dispatcher != nullptr) {
     job.active.store(false, std::memory_order_relaxed);               // the dispatcher only ranks; order is not needed
@@ -204,13 +203,13 @@ std::int64_t Worker::run_job(std::int64_t release_abs) {
 std::int64_t Worker::prepare() {
   if (schedule.on_at >= 0) return exec->epoch_ns() + schedule.on_at * task->period_ns();  // a switch: on then
   if (task->state() != TaskState::kOn) {
-    precedence.scheduled.store(-1, std::memory_order_release);  // release: successors stop waiting on us
+    precedence->scheduled.store(-1, std::memory_order_release);  // release: successors stop waiting on us
     return kNever;
   }
   if (schedule.held) return kNever;  // waiting for kJoin; `scheduled` is the control thread's until then
   const std::int64_t release_abs = exec->epoch_ns() + schedule.k * task->period_ns();
   if (schedule.leave_seq != 0 && release_abs >= schedule.leave_at) return 0;  // a switch: leave now
-  precedence.scheduled.store(schedule.k, std::memory_order_release);          // release: pairs with successors' acquire
+  precedence->scheduled.store(schedule.k, std::memory_order_release);         // release: pairs with successors' acquire
   return release_abs;
 }
 
@@ -231,9 +230,10 @@ void Worker::act() {
   if (late.skipped != 0) {
     schedule.k += static_cast<std::int64_t>(late.skipped);
     task->skip_releases(late.skipped, now);
-    precedence.scheduled.store(schedule.k, std::memory_order_release);  // release: as in prepare()
+    precedence->scheduled.store(schedule.k, std::memory_order_release);  // release: as in prepare()
     // A successor asleep on one of the releases skipped must look again now, not at its bound.
-    if (precedence.waiters.load(std::memory_order_seq_cst) != 0) detail::futex_wake_all(precedence.completed);
+    if (precedence->waiters.load(std::memory_order_seq_cst) != 0)
+      detail::futex_wake_all(precedence->completed, futex_scope);
     if (task->state() != TaskState::kOn || now < late.next_release) return;
     if (schedule.leave_seq != 0 && epoch + schedule.k * period >= schedule.leave_at) {
       leave();  // the releases skipped reached the commit: the joining task runs this one
@@ -248,13 +248,14 @@ void Worker::act() {
   schedule.last_run = schedule.k;
   // seq_cst store, then seq_cst load of `waiters`: with the successor's seq_cst increment and
   // re-check this is Dekker's pattern, so either it sees our store or we see it waiting.
-  precedence.completed.store(static_cast<std::uint32_t>(schedule.k + 1), std::memory_order_seq_cst);
-  if (precedence.waiters.load(std::memory_order_seq_cst) != 0) detail::futex_wake_all(precedence.completed);
+  precedence->completed.store(static_cast<std::uint32_t>(schedule.k + 1), std::memory_order_seq_cst);
+  if (precedence->waiters.load(std::memory_order_seq_cst) != 0)
+    detail::futex_wake_all(precedence->completed, futex_scope);
   ++schedule.k;  // under late: run a late cycle runs late; the next release stays on the absolute grid
   // Successors learn at once which release comes next (not at this thread's next pass, which other
   // members may delay): a consumer tells a producer that is behind from one that is not by it.
   if (task->state() == TaskState::kOn && (schedule.leave_seq == 0 || epoch + schedule.k * period < schedule.leave_at))
-    precedence.scheduled.store(schedule.k, std::memory_order_release);  // release: as in prepare()
+    precedence->scheduled.store(schedule.k, std::memory_order_release);  // release: as in prepare()
 }
 
 void Worker::run_aperiodic() {
@@ -265,7 +266,7 @@ void Worker::run_aperiodic() {
   const bool exhausted = served && server.exhausted();
   const int fd = task->trigger().fd;
   std::array<pollfd, 2> fds{pollfd{bell_fd, POLLIN, 0}, pollfd{fd, POLLIN, 0}};
-  if (exhausted || !wake.update_pending.load(std::memory_order_acquire)) {  // acquire: pairs with the producer
+  if (exhausted || !task->wake().update_pending.load(std::memory_order_acquire)) {  // acquire: pairs with the producer
     // An exhausted server waits for its next refill, and does not watch the event source meanwhile.
     const nfds_t n = (fd >= 0 && !exhausted) ? 2 : 1;
     timespec rel{};
@@ -283,7 +284,8 @@ void Worker::run_aperiodic() {
   if (mailbox.request_seq.load(std::memory_order_acquire) != req) return;  // the mail first; acquire: as in main
   if (exhausted || task->state() != TaskState::kOn) return;
   const bool fd_event = fd >= 0 && (fds[1].revents & (POLLIN | POLLERR | POLLHUP)) != 0;
-  const bool update_event = wake.update_pending.exchange(false, std::memory_order_acq_rel);  // acq_rel: see run_job
+  const bool update_event =
+      task->wake().update_pending.exchange(false, std::memory_order_acq_rel);  // acq_rel: see run_job
   if (!fd_event && !update_event) return;
 
   const std::int64_t release_abs = monotonic_ns();
@@ -304,15 +306,15 @@ void Worker::wait_for_predecessors(std::int64_t release, std::int64_t release_ab
   for (Worker* p : predecessors) {
     for (;;) {
       // acquire: its cycle's outputs are published
-      const std::uint32_t done = p->precedence.completed.load(std::memory_order_acquire);
+      const std::uint32_t done = p->precedence->completed.load(std::memory_order_acquire);
       const bool completed = reached(done, release);
       const bool completed_previous = reached(done, release - 1);
-      const std::int64_t joins = p->precedence.joining_k.load(std::memory_order_acquire);  // acquire: the commit's
+      const std::int64_t joins = p->precedence->joining_k.load(std::memory_order_acquire);  // acquire: the commit's
       const bool joining = joins >= 0 && joins <= release;
       // A joining producer is waited for at its first release as if it were ON already.
       const bool on = joining || p->task->state() == TaskState::kOn;
       // acquire: pairs with its store of the release it is about to run
-      const std::int64_t next = joining ? joins : p->precedence.scheduled.load(std::memory_order_acquire);
+      const std::int64_t next = joining ? joins : p->precedence->scheduled.load(std::memory_order_acquire);
       if (p->group == group) {
         // A producer on this thread has had its turn in this pass (it comes first in data-flow
         // order); if it has not run the release it is behind, and can only catch up once we
@@ -329,17 +331,17 @@ void Worker::wait_for_predecessors(std::int64_t release, std::int64_t release_ab
       if (spin_until > 0 && p->cpu != cpu) {
         // Catching up: the producer, on another CPU, is running the releases just before ours
         // one after another; a futex sleep and wake per release would cost more than the job.
-        while (!reached(p->precedence.completed.load(std::memory_order_acquire), release) &&  // acquire: as above
+        while (!reached(p->precedence->completed.load(std::memory_order_acquire), release) &&  // acquire: as above
                monotonic_ns() < spin_until) {
           cpu_relax();
         }
-        if (reached(p->precedence.completed.load(std::memory_order_acquire), release)) continue;  // acquire: as above
+        if (reached(p->precedence->completed.load(std::memory_order_acquire), release)) continue;  // acquire: as above
       }
-      p->precedence.waiters.fetch_add(1, std::memory_order_seq_cst);  // seq_cst: Dekker with the producer (see act)
-      const std::uint32_t c = p->precedence.completed.load(std::memory_order_seq_cst);
+      p->precedence->waiters.fetch_add(1, std::memory_order_seq_cst);  // seq_cst: Dekker with the producer (see act)
+      const std::uint32_t c = p->precedence->completed.load(std::memory_order_seq_cst);
       bool in_time = true;
-      if (!reached(c, release)) in_time = detail::futex_wait(p->precedence.completed, c, give_up);
-      p->precedence.waiters.fetch_sub(1, std::memory_order_relaxed);  // only a hint for the producer's wake
+      if (!reached(c, release)) in_time = detail::futex_wait(p->precedence->completed, c, give_up, p->futex_scope);
+      p->precedence->waiters.fetch_sub(1, std::memory_order_relaxed);  // only a hint for the producer's wake
       if (!in_time && monotonic_ns() >= give_up) {
         task->record_order_timeout();
         return;  // past the bound: run with what the table holds

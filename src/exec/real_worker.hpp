@@ -19,6 +19,7 @@
 #include <limits>
 #include <vector>
 
+#include "futex.hpp"
 #include "sporadic_server.hpp"
 #include "task.hpp"
 #include "urgency.hpp"
@@ -81,7 +82,7 @@ struct Worker {
   int cpu = 0;
   int fixed_priority = 1;                    // SCHED_FIFO priority under rm / dm (and at start)
   PriorityDispatcher* dispatcher = nullptr;  // edf / muf: who ranks its jobs
-  int bell_fd = -1;                          // aperiodic: eventfd rung by signals and producers
+  int bell_fd = -1;                          // aperiodic: eventfd rung by signals and producers, in any process
   // The thread that runs it: changed only when the stuck-task watch moves it off a stuck thread,
   // under the control mutex and before the new thread starts. Other tasks' threads compare
   // `group` instead, which never changes.
@@ -102,17 +103,10 @@ struct Worker {
     std::uint32_t seen = 0;  // the last mail handled; the task's thread's
   } mailbox;
 
-  /// What same-period successors read of it (the same-rate rule).
-  struct Precedence {
-    // The last release completed (+1, modulo 2^32), and how many successors sleep on it.
-    alignas(64) std::atomic<std::uint32_t> completed{0};
-    std::atomic<std::uint32_t> waiters{0};
-    std::atomic<std::int64_t> scheduled{-1};  // release index about to run; -1 when not released
-    // A switch's commit: the release this (still OFF) task will join at; -1 when none. Successors
-    // wait for it at that release as if it were ON, so that a commit running late cannot make them
-    // read the leaving producer's last value.
-    std::atomic<std::int64_t> joining_k{-1};
-  } precedence;
+  /// What same-period successors read of it (the same-rate rule): its task's, in the task block
+  /// with module processes; futex waits and wakes on it are then process-shared.
+  TaskPrecedence* precedence = nullptr;
+  detail::FutexScope futex_scope = detail::FutexScope::kProcess;
 
   /// The job it publishes for its dispatcher (edf / muf), and its own thread handle for it.
   struct DispatchedJob {
@@ -122,16 +116,6 @@ struct Worker {
     std::atomic<pthread_t> self{};
     std::atomic<int> current_priority{0};  // what it runs at (set by itself or its dispatcher)
   } job;
-
-  /// The job it is running, for the overrun watch (service_thread.cpp): its absolute deadline
-  /// (executive clock), which names the job; kNever while no job runs.
-  alignas(64) std::atomic<std::int64_t> running_deadline_ns{kNever};
-
-  /// Aperiodic triggers: the variable it waits on (-1: none), and an update not yet served.
-  struct Wake {
-    alignas(64) std::atomic<int> trigger_var{-1};
-    std::atomic<bool> update_pending{false};
-  } wake;
 
   /// Touched only by the task's thread: its place on the grid, and a group start or a switch
   /// it is in the middle of.

@@ -81,8 +81,8 @@ void RealExecutive::give_up(Worker& w, const Task::Busy& busy, std::int64_t now_
   // Its jobs are no one's to rank any more (edf, muf), and its successors asleep on its release
   // look again: it is not ON, so they no longer wait for it.
   w.job.active.store(false, std::memory_order_relaxed);  // the dispatcher only ranks; nothing is published with it
-  w.precedence.scheduled.store(-1, std::memory_order_release);  // release: as in Worker::prepare()
-  detail::futex_wake_all(w.precedence.completed);
+  w.precedence->scheduled.store(-1, std::memory_order_release);  // release: as in Worker::prepare()
+  detail::futex_wake_all(w.precedence->completed, w.futex_scope);
   if (w.dispatcher != nullptr) w.dispatcher->poke();
   if (stuck.running) (void)drop_to_idle(stuck.handle);
   if (mates.empty()) return;

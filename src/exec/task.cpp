@@ -423,8 +423,10 @@ Result<void> Task::clear(std::int64_t now_ns) {
 }
 
 void Task::lose_process(const char* reason, std::int64_t now_ns) noexcept {
-  // The dead process may have died inside a method: its heartbeat must not outlive it.
+  // The dead process may have died inside a method, or a job: neither its heartbeat nor the job's
+  // overrun may outlive it.
   shared_->busy_since_ns.store(TaskShared::kIdle, std::memory_order_release);  // release: as in BusyScope
+  set_running_deadline(TaskShared::kNoJob);
   const TaskState before = state();
   if (before == TaskState::kNotCreated) return;
   if (before != TaskState::kError) set_state(TaskState::kError);

@@ -159,6 +159,21 @@ class Task {
   /// On the task's thread, after a method: it was given up while it ran, and this thread must
   /// touch neither the task nor its thread-mates again.
   [[nodiscard]] bool given_up() const noexcept { return given_up_; }
+  /// What its same-period successors read of it, in any process. Real-time safe.
+  [[nodiscard]] TaskPrecedence& precedence() noexcept { return shared_->precedence; }
+  /// Its aperiodic trigger's state, where its producers in any process find it. Real-time safe.
+  [[nodiscard]] TaskWake& wake() noexcept { return shared_->wake; }
+  /// The job this task's thread is running: its absolute deadline (subsystem clock), or kNoJob.
+  /// Set around each job by the task's thread; read by the overrun watch. Real-time safe.
+  void set_running_deadline(std::int64_t deadline_ns) noexcept {
+    // Relaxed: a status word on its own; the watch only compares it with the clock.
+    shared_->running_deadline_ns.store(deadline_ns, std::memory_order_relaxed);
+  }
+  [[nodiscard]] std::optional<std::int64_t> running_deadline() const noexcept {
+    const std::int64_t deadline = shared_->running_deadline_ns.load(std::memory_order_relaxed);  // relaxed: as above
+    if (deadline == TaskShared::kNoJob) return std::nullopt;
+    return deadline;
+  }
   /// The heartbeat as it stands: the method the task's thread is inside and since when (subsystem
   /// clock), if any. Any thread.
   struct Busy {

@@ -25,6 +25,30 @@ enum class BusyIn : std::uint8_t { kInit, kOn, kCycle, kOff, kKill, kClear, kRei
 /// The method's name as the module's author wrote it ("cycle").
 const char* busy_in_name(BusyIn method) noexcept;
 
+/// What wakes an aperiodic task on an update of a variable (Trigger::update_port): the variable it
+/// waits on (-1: none) and an update not yet served. Written by its producers' threads, in any
+/// process, so it has a cache line of its own.
+struct TaskWake {
+  alignas(64) std::atomic<int> trigger_var{-1};
+  std::atomic<bool> update_pending{false};
+};
+
+/// What same-period successors read of a task (the same-rate rule, docs/architecture.md), written
+/// by its thread and read, and slept on, by theirs: in the task block with module processes, so
+/// that a successor in another process waits for it as one of its own process does.
+struct TaskPrecedence {
+  // The last release completed (+1, modulo 2^32), and how many successors sleep on it. A
+  // successor of a process that died asleep leaves its count behind: its producer then makes one
+  // futex wake too many a cycle, never one too few.
+  alignas(64) std::atomic<std::uint32_t> completed{0};
+  std::atomic<std::uint32_t> waiters{0};
+  std::atomic<std::int64_t> scheduled{-1};  // release index about to run; -1 when not released
+  // A switch's commit: the release this (still OFF) task will join at; -1 when none. Successors
+  // wait for it at that release as if it were ON, so that a commit running late cannot make them
+  // read the leaving producer's last value.
+  std::atomic<std::int64_t> joining_k{-1};
+};
+
 struct TaskShared {
   static constexpr std::size_t kEventCapacity = 64;
   static constexpr std::int64_t kIdle = std::numeric_limits<std::int64_t>::min();
@@ -39,10 +63,17 @@ struct TaskShared {
   /// process whose task stays too long in one; the main process's own stuck cycles are given up.
   std::atomic<std::int64_t> busy_since_ns{kIdle};
   std::atomic<BusyIn> busy_in{BusyIn::kCycle};
+  /// The job the task's thread is running, for the overrun watch (service_thread.cpp), which the
+  /// main process runs over every task, a module process's too: its absolute deadline (subsystem
+  /// clock), which names the job; kNoJob while none runs.
+  static constexpr std::int64_t kNoJob = std::numeric_limits<std::int64_t>::max();
+  std::atomic<std::int64_t> running_deadline_ns{kNoJob};
   /// The configuration the task's module asks for (index in the file, -1: none), where the file
   /// has module processes: the request board's slot (reconfig/request_board.hpp), shared so that a
   /// module process's task can ask. Written by the task's thread, cleared by the service thread.
   std::atomic<int> switch_request{-1};
+  TaskWake wake;
+  TaskPrecedence precedence;
   TaskStats stats;
   EventRing<kEventCapacity> events;
 };

@@ -6,6 +6,8 @@
 
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "chimera/config/subsystem.hpp"
 #include "chimera/module/registry.hpp"
@@ -13,14 +15,15 @@
 namespace chimera {
 
 struct ModuleProcessArgs {
-  std::string process;                       // the name of the process whose tasks it runs
-  std::string table;                         // the global table's subsystem name (with the run's suffix)
-  int socket_fd = -1;                        // the command socket
-  int block_fd = -1;                         // the task block's memfd
-  int life = -1;                             // its life lock in the task block (held while it lives); -1: none
-  int history_fd = -1;                       // the flight recorder's shared rings (a memfd); -1: none kept
-  double record_seconds = 0;                 // the history the main process laid those rings out for
-  std::optional<std::string> configuration;  // the start configuration (the first plan)
+  std::string process;                             // the name of the process whose tasks it runs
+  std::string table;                               // the global table's subsystem name (with the run's suffix)
+  int socket_fd = -1;                              // the command socket
+  int block_fd = -1;                               // the task block's memfd
+  int life = -1;                                   // its life lock in the task block (held while it lives); -1: none
+  int history_fd = -1;                             // the flight recorder's shared rings (a memfd); -1: none kept
+  double record_seconds = 0;                       // the history the main process laid those rings out for
+  std::vector<std::pair<std::size_t, int>> bells;  // the aperiodic tasks' eventfds (task, fd), the main process's
+  std::optional<std::string> configuration;        // the start configuration (the first plan)
   bool realtime_priorities = true;
   bool measure_cpu_time = false;
   bool rt_check = false;

@@ -23,6 +23,7 @@
 #include "chimera/control/subsystem.hpp"
 #include "chimera/module/registry.hpp"
 #include "run_chimera.hpp"
+#include "started_subsystem.hpp"
 
 namespace chimera {
 namespace {
@@ -111,19 +112,10 @@ class ModuleProcessTest : public ::testing::Test {
     }
     const std::string path = dir_.file("fig4_processes.yaml");
     test::write_text(path, file_text(dir_));
-    auto plugins = load_file_plugins(path);
-    ASSERT_TRUE(plugins.ok()) << plugins.error().message;
-    auto spec = load_subsystem_file(path, Registry::global());
-    ASSERT_TRUE(spec.ok()) << spec.error().message;
     RunOptions options;
-    options.realtime_priorities = false;  // the test runs anywhere; priorities are not its subject
-    options.shm_suffix = "_" + std::to_string(::getpid());
-    options.worker_program = CHIMERA_BIN;
     adjust(options);
-    auto made = Subsystem::create(*spec, Registry::global(), options);
-    ASSERT_TRUE(made.ok()) << made.error().message;
-    subsystem_ = std::move(*made);
-    ASSERT_TRUE(subsystem_->start().ok());
+    subsystem_ = test::started_subsystem(path, options);
+    ASSERT_NE(subsystem_, nullptr);
   }
 
   virtual void adjust(RunOptions& /*options*/) {}
@@ -281,6 +273,123 @@ TEST_F(ModuleProcessRecorderTest, TheRecorderHoldsWhatAModuleProcessWroteUntilIt
   for (const auto& entry : std::filesystem::directory_iterator(dumps(), ec))
     named = named || test::read_text(entry.path().string() + "/summary.txt").find("segv") != std::string::npos;
   EXPECT_TRUE(named) << "no dump below " << dumps() << " names segv";
+}
+
+// The overrun watch covers a module process's tasks: a hard task there whose cycle does not return
+// is reported once past its deadline and holds the illegal-configuration flag while it runs over
+// (the robot holds), until the supervisor kills its process for the stuck cycle (ERROR). The
+// death takes the overrun with it: once cleared and on again in a new process, no hold is left.
+TEST(ModuleProcessOverrun, AHardTaskOverdueInAModuleProcessHoldsTheFlagUntilItsProcessEnds) {
+  TempDir dir;
+  const std::string path = dir.file("overdue.yaml");
+  test::write_text(path,
+                   "subsystem: overdue\n"
+                   "plugins: [" FAULTY_PLUGIN
+                   "]\n"
+                   "tasks:\n"
+                   "  - {name: tick, module: segfault_in_cycle, period: 2ms, criticality: soft,"
+                   " params: {after: 1000000000}}\n"
+                   "  - name: late\n"
+                   "    module: loop_in_cycle\n"
+                   "    period: 100ms\n"
+                   "    criticality: hard\n"
+                   "    process: slow\n"
+                   "    rename: {faulty_count: late_count}\n"
+                   "    params: {after: 3, once_file: " +
+                       dir.file("late.once") + "}\n");
+  const auto started = test::started_subsystem(path);
+  ASSERT_NE(started, nullptr);
+  Subsystem& s = *started;
+
+  // Stuck from its 3rd cycle (released at 0.2 s): reported a watch tick past its deadline, while
+  // its process still runs (the supervisor's bound is ten periods).
+  std::string overdue;
+  bool held_while_overdue = false;
+  for (int i = 0; i < kMaxSteps && overdue.empty(); ++i) {
+    s.run_for(kStepNs);
+    for (const Event& e : s.drain_events())
+      if (e.task == "late" && e.text.find("still running") != std::string::npos) overdue = e.text;
+    if (!overdue.empty())
+      held_while_overdue = s.illegal_configuration() && task_of(s.snapshot(), "late").state == TaskState::kOn;
+  }
+  ASSERT_FALSE(overdue.empty()) << "the main process's watch never saw the module process's job run over";
+  EXPECT_NE(overdue.find("The illegal-configuration flag is up until it ends"), std::string::npos) << overdue;
+  EXPECT_TRUE(held_while_overdue) << "the flag was not up while the hard job ran over, its process alive";
+
+  ASSERT_TRUE(run_until(s, [](const auto& all) { return task_of(all, "late").state == TaskState::kError; }));
+  EXPECT_NE(task_of(s.snapshot(), "late").last_error.find("killed by the supervisor: late stuck in cycle()"),
+            std::string::npos)
+      << task_of(s.snapshot(), "late").last_error;
+  ASSERT_TRUE(s.signal("late", Signal::kClear).ok());
+  ASSERT_TRUE(s.signal("late", Signal::kOn).ok());
+  const auto cycled = [](const std::vector<TaskSnapshot>& all) { return task_of(all, "late").stats.cycles >= 5; };
+  ASSERT_TRUE(run_until(s, cycled));
+  EXPECT_FALSE(s.illegal_configuration()) << "a hold outlived the job that died with its process";
+  s.stop();
+}
+
+// Aperiodic tasks are woken by their producers whatever process each is in: a ticker of the main
+// process wakes a counter in a module process, and a ticker there wakes a counter of the main
+// process. Each counter runs about a cycle per tick (an update seen late may serve two).
+TEST(ModuleProcessTriggers, AnAperiodicTaskIsWokenByAProducerInAnotherProcess) {
+  TempDir dir;
+  const std::string path = dir.file("triggers.yaml");
+  test::write_text(path,
+                   "subsystem: triggers\n"
+                   "plugins: [" FAULTY_PLUGIN
+                   "]\n"
+                   "tasks:\n"
+                   "  - {name: tick_main, module: segfault_in_cycle, period: 5ms, criticality: soft,"
+                   " params: {after: 1000000000}}\n"
+                   "  - {name: count_side, module: counts_updates, criticality: soft, process: side,"
+                   " rename: {x: faulty_count, updates: side_updates}}\n"
+                   "  - {name: tick_side, module: exit_in_cycle, period: 5ms, criticality: soft, process: side,"
+                   " rename: {faulty_count: side_count}, params: {after: 1000000000}}\n"
+                   "  - {name: count_main, module: counts_updates, criticality: soft,"
+                   " rename: {x: side_count, updates: main_updates}}\n");
+  const auto started = test::started_subsystem(path);
+  ASSERT_NE(started, nullptr);
+  Subsystem& s = *started;
+  const auto counted = [](const std::vector<TaskSnapshot>& all) {
+    return task_of(all, "count_side").stats.cycles >= 40 && task_of(all, "count_main").stats.cycles >= 40;
+  };
+  EXPECT_TRUE(run_until(s, counted)) << "count_side ran " << task_of(s.snapshot(), "count_side").stats.cycles
+                                     << " cycles, count_main " << task_of(s.snapshot(), "count_main").stats.cycles;
+  // Woken by the ticks, not by anything else: never more cycles than ticks.
+  const auto now = s.snapshot();
+  EXPECT_LE(task_of(now, "count_side").stats.cycles, task_of(now, "tick_main").stats.cycles + 2);
+  EXPECT_LE(task_of(now, "count_main").stats.cycles, task_of(now, "tick_side").stats.cycles + 2);
+  s.stop();
+}
+
+// The same-rate rule across processes: a consumer of the main process reads its producer's value
+// of the same release though the producer runs in a module process. A release that read another
+// must be one the rule gave up waiting for (counted as an order timeout: a loaded machine), so
+// mismatches never exceed those; without the rule across processes nearly every release of a
+// consumer that runs first would read the release before.
+TEST(ModuleProcessPrecedence, AConsumerReadsItsProducersValueOfTheSameReleaseAcrossProcesses) {
+  TempDir dir;
+  const std::string path = dir.file("same_rate.yaml");
+  test::write_text(path,
+                   "subsystem: same_rate\n"
+                   "plugins: [" FAULTY_PLUGIN
+                   "]\n"
+                   "tasks:\n"
+                   "  - {name: stamp, module: release_stamp, period: 5ms, criticality: soft, process: side}\n"
+                   "  - {name: check, module: checks_stamp, period: 5ms, criticality: soft}\n");
+  const auto started = test::started_subsystem(path);
+  ASSERT_NE(started, nullptr);
+  Subsystem& s = *started;
+  ASSERT_TRUE(run_until(s, [](const auto& all) { return task_of(all, "check").stats.cycles >= 300; }));
+  // The count first, then the timeouts: a release between the two can only add a timeout.
+  auto mismatches = s.get("stamp_mismatches");
+  ASSERT_TRUE(mismatches.ok()) << mismatches.error().message;
+  const auto check = task_of(s.snapshot(), "check");
+  s.stop();
+  EXPECT_LE((*mismatches)[0], static_cast<double>(check.stats.order_timeouts) + 1.0)
+      << "of " << check.stats.cycles << " releases, " << (*mismatches)[0] << " read another release's stamp and "
+      << check.stats.order_timeouts << " gave up waiting for it";
+  EXPECT_LT(check.stats.order_timeouts, check.stats.cycles / 2) << "the rule gave up on most releases";
 }
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include "chimera/control/subsystem.hpp"
 #include "chimera/module/registry.hpp"
 #include "run_chimera.hpp"
+#include "started_subsystem.hpp"
 
 namespace chimera {
 namespace {
@@ -49,16 +50,9 @@ TEST(ProcessSwitch, BackAndForthBetweenTheMainProcessAndAModuleProcess) {
   TempDir dir;
   const std::string path = dir.file("process_switch.yaml");
   test::write_text(path, kFile);
-  auto spec = load_subsystem_file(path, Registry::global());
-  ASSERT_TRUE(spec.ok()) << spec.error().message;
-  RunOptions options;
-  options.realtime_priorities = false;
-  options.shm_suffix = "_" + std::to_string(::getpid());
-  options.worker_program = CHIMERA_BIN;
-  auto made = Subsystem::create(*spec, Registry::global(), options);
-  ASSERT_TRUE(made.ok()) << made.error().message;
-  Subsystem& s = **made;
-  ASSERT_TRUE(s.start().ok());
+  const auto started = test::started_subsystem(path);  // a file without plugins: none loaded
+  ASSERT_NE(started, nullptr);
+  Subsystem& s = *started;
   // Not in the start configuration: the first switch creates it, and starts its process.
   ASSERT_EQ(task_of(s.snapshot(), "traj_there").state, TaskState::kNotCreated);
 
@@ -112,18 +106,9 @@ TEST(ProcessSwitch, AModuleInAModuleProcessAsksForSwitches) {
                    "requests:\n"
                    "  - {from: first, to: second, by: to_second}\n"
                    "  - {from: second, to: first, by: to_first}\n");
-  auto plugins = load_file_plugins(path);
-  ASSERT_TRUE(plugins.ok()) << plugins.error().message;
-  auto spec = load_subsystem_file(path, Registry::global());
-  ASSERT_TRUE(spec.ok()) << spec.error().message;
-  RunOptions options;
-  options.realtime_priorities = false;
-  options.shm_suffix = "_" + std::to_string(::getpid());
-  options.worker_program = CHIMERA_BIN;
-  auto made = Subsystem::create(*spec, Registry::global(), options);
-  ASSERT_TRUE(made.ok()) << made.error().message;
-  Subsystem& s = **made;
-  ASSERT_TRUE(s.start().ok());
+  const auto started = test::started_subsystem(path);
+  ASSERT_NE(started, nullptr);
+  Subsystem& s = *started;
   for (int i = 0; i < kMaxSteps && s.switches().size() < 4; ++i) s.run_for(kStepNs);
   const auto switches = s.switches();
   ASSERT_GE(switches.size(), 4U) << "the askers' requests did not reach the main process";

@@ -1,8 +1,9 @@
 // Modules that end or hang their process the ways a faulty module does (issue 15): a write through
-// a null pointer, abort(), exit(3), and an endless loop in cycle() or on(); and one that asks for
-// switches, to be run in a module process. Each publishes a counter (so it is a writer of the
-// table like any other) and ends its process at cycle `after`; with `once_file` set, only while that file does not
-// exist (it creates it first), so that a restarted process runs on.
+// a null pointer, abort(), exit(3), and an endless loop in cycle() or on(); and some to be run in
+// module processes beside others: one that asks for switches, one woken by a variable's updates,
+// and a producer and consumer that tell whether the same-rate rule held between them. Each publishes a counter (so it
+// is a writer of the table like any other) and ends its process at cycle `after`; with `once_file` set, only while that
+// file does not exist (it creates it first), so that a restarted process runs on.
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -138,6 +139,91 @@ class AsksForSwitch final : public chimera::Module {
   long cycles_ = 0;
 };
 
+// Not faulty: aperiodic, one cycle for each new value of its in-var `x` (trigger_on_update), which
+// it counts into `updates`; to be woken across processes.
+class CountsUpdates final : public chimera::Module {
+ public:
+  static constexpr const char* kName = "counts_updates";
+  static constexpr const char* kSummary = "counts the updates of x that woke it (a test of module processes)";
+  static constexpr const char* kDoc = "Aperiodic: a cycle for each new value of `x`; `updates` counts them.";
+  static void declare(chimera::Declarations& d, const chimera::Params& /*params*/) {
+    d.in_var("x", chimera::Dim::fixed(1), "the variable whose updates wake it");
+    d.out_var("updates", chimera::Dim::fixed(1), "cycles run");
+  }
+
+ protected:
+  chimera::Status init(chimera::InitContext& ctx) override {
+    x_ = ctx.in<double>("x");
+    updates_ = ctx.out<double>("updates");
+    ctx.trigger_on_update("x");
+    return chimera::Status::ok();
+  }
+  chimera::Status cycle() override {
+    updates_[0] += 1.0;
+    return chimera::Status::ok();
+  }
+
+ private:
+  chimera::In<double> x_;
+  chimera::Out<double> updates_;
+};
+
+// Not faulty: a producer that writes its release (ns since start) as `stamp`, and a consumer of the
+// same period that counts the releases whose stamp is not its own (`stamp_mismatches`): with the
+// same-rate rule the consumer reads its producer's value of the same release, in any process.
+class ReleaseStamp final : public chimera::Module {
+ public:
+  static constexpr const char* kName = "release_stamp";
+  static constexpr const char* kSummary = "writes its release as stamp (a test of the same-rate rule)";
+  static constexpr const char* kDoc = "Each cycle: stamp = its release, ns since start.";
+  static void declare(chimera::Declarations& d, const chimera::Params& /*params*/) {
+    d.out_var("stamp", chimera::Dim::fixed(1), "the release of the cycle that wrote it, ns");
+  }
+
+ protected:
+  chimera::Status init(chimera::InitContext& ctx) override {
+    stamp_ = ctx.out<double>("stamp");
+    timing_ = &ctx.timing();
+    return chimera::Status::ok();
+  }
+  chimera::Status cycle() override {
+    stamp_[0] = static_cast<double>(timing_->release_ns);
+    return chimera::Status::ok();
+  }
+
+ private:
+  chimera::Out<double> stamp_;
+  const chimera::CycleTiming* timing_ = nullptr;
+};
+
+class ChecksStamp final : public chimera::Module {
+ public:
+  static constexpr const char* kName = "checks_stamp";
+  static constexpr const char* kSummary = "counts stamps not of its own release (a test of the same-rate rule)";
+  static constexpr const char* kDoc = "Each cycle: stamp_mismatches += 1 unless stamp is its own release.";
+  static void declare(chimera::Declarations& d, const chimera::Params& /*params*/) {
+    d.in_var("stamp", chimera::Dim::fixed(1), "a producer's release, ns");
+    d.out_var("stamp_mismatches", chimera::Dim::fixed(1), "releases that read another release's stamp");
+  }
+
+ protected:
+  chimera::Status init(chimera::InitContext& ctx) override {
+    stamp_ = ctx.in<double>("stamp");
+    mismatches_ = ctx.out<double>("stamp_mismatches");
+    timing_ = &ctx.timing();
+    return chimera::Status::ok();
+  }
+  chimera::Status cycle() override {
+    if (stamp_[0] != static_cast<double>(timing_->release_ns)) mismatches_[0] += 1.0;
+    return chimera::Status::ok();
+  }
+
+ private:
+  chimera::In<double> stamp_;
+  chimera::Out<double> mismatches_;
+  const chimera::CycleTiming* timing_ = nullptr;
+};
+
 }  // namespace
 
 CHIMERA_REGISTER_MODULE(SegfaultInCycle);
@@ -146,3 +232,6 @@ CHIMERA_REGISTER_MODULE(ExitInCycle);
 CHIMERA_REGISTER_MODULE(LoopInCycle);
 CHIMERA_REGISTER_MODULE(LoopInOn);
 CHIMERA_REGISTER_MODULE(AsksForSwitch);
+CHIMERA_REGISTER_MODULE(CountsUpdates);
+CHIMERA_REGISTER_MODULE(ReleaseStamp);
+CHIMERA_REGISTER_MODULE(ChecksStamp);
