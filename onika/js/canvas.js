@@ -3,6 +3,8 @@
 // input are bound to the same state variable. Nobody draws a wire: the links follow from the
 // port names and the renames, which is the methodology's point. Fan-out is one output drawn to
 // several inputs; a variable with no producer, or with two, is drawn in red with the reason.
+// Boxes are placed from the data flow; one dragged elsewhere stays where it was put (the
+// `layout` the page keeps per configuration), and the links follow it.
 
 import { svg, clear, durationText } from './dom.js';
 
@@ -13,6 +15,8 @@ const HEADER = 34;
 const ROW = 18;
 const GAP = 36;
 const MARGIN = 40;
+const SNAP = 10; // a moved box lands on this grid
+const DRAG_START = 4; // a press that moves less is a click
 
 /** The links of a configuration: output to input of the same variable, and what has no end. */
 export function linksOf(tasks) {
@@ -59,11 +63,18 @@ export function layers(tasks, links) {
 }
 
 export class Canvas {
-  constructor(root, { onDrop, onPort, onTask, label }) {
+  /**
+   * `layout` ({get(configuration), set(configuration, task, {x, y})}) keeps where boxes were
+   * moved; without it boxes stay where the data flow puts them.
+   */
+  constructor(root, { onDrop, onPort, onTask, label, layout }) {
     this.root = root;
     this.onDrop = onDrop;
     this.onPort = onPort;
     this.onTask = onTask;
+    this.layout = layout;
+    this.justMoved = false;
+    this.last = null;
     this.svg = svg('svg', { class: 'canvas', role: 'img', 'aria-label': label || 'configuration' });
     root.append(this.svg);
     root.addEventListener('dragover', (event) => {
@@ -82,6 +93,7 @@ export class Canvas {
 
   /** Draws `configuration` ({name, tasks, violations}) of `model`, states from `status`. */
   draw(model, configuration, states) {
+    this.last = [model, configuration, states];
     clear(this.svg);
     const tasks = configuration ? configuration.tasks.map((n) => model.tasks.find((t) => t.name === n)).filter(Boolean) : [];
     this.root.dataset.configuration = configuration ? configuration.name : '';
@@ -104,7 +116,13 @@ export class Canvas {
       heights[c] = y + h + GAP;
       place.set(t.name, { x: MARGIN + c * COLUMN, y, h, ins, outs });
     });
-    const bottom = Math.max(...heights) - GAP;
+    const moved = this.layout ? this.layout.get(configuration.name) : {};
+    for (const [name, at] of place) {
+      const to = moved[name];
+      if (to && Number.isFinite(to.x) && Number.isFinite(to.y)) Object.assign(at, { x: to.x, y: to.y, moved: true });
+    }
+    const boxes = [...place.values()];
+    const bottom = Math.max(...boxes.map((b) => b.y + b.h));
     const portY = (box, list, p) => box.y + HEADER + list.indexOf(p) * ROW + ROW / 2;
     const linkLayer = svg('g', { class: 'links' });
     const boxLayer = svg('g', { class: 'boxes' });
@@ -145,22 +163,74 @@ export class Canvas {
         svg('text', { x: b.x - 38, y: y + 4, class: `link-label end${bad.has(u.port.variable) ? ' bad' : ''}` }, u.port.variable),
       );
     }
-    for (const t of tasks) boxLayer.append(this.box(t, place.get(t.name), states.get(t.name), bad));
+    for (const t of tasks) boxLayer.append(this.box(t, place.get(t.name), states.get(t.name), bad, configuration.name));
     this.svg.append(linkLayer, boxLayer);
-    const width = MARGIN * 2 + (Math.max(...column) + 1) * COLUMN - (COLUMN - BOX_WIDTH);
+    // Everything in view, boxes moved left or up of the grid too (dangling inputs' labels on the left).
+    const left = Math.min(0, ...boxes.map((b) => b.x - MARGIN)) - 40;
+    const top = Math.min(0, ...boxes.map((b) => b.y - MARGIN));
+    const right = Math.max(...boxes.map((b) => b.x + BOX_WIDTH)) + MARGIN;
     const height = bottom + 40 + 16 * loop;
-    this.svg.setAttribute('viewBox', `-40 0 ${width + 40} ${height}`);
+    this.svg.setAttribute('viewBox', `${left} ${top} ${right - left} ${height - top}`);
   }
 
-  box(task, at, state, bad) {
-    const g = svg('g', { class: `task state-${(state || 'NOT-CREATED').replace(/\s/g, '-')}`, 'data-task': task.name });
+  /** Draws again what it drew last (a box moved). */
+  redraw() {
+    if (this.last) this.draw(...this.last);
+  }
+
+  /** A pointer event's place in the drawing's coordinates. */
+  point(event) {
+    return new DOMPoint(event.clientX, event.clientY).matrixTransform(this.svg.getScreenCTM().inverse());
+  }
+
+  /** Lets box `g` be dragged (anywhere but by a port); where it is let go is kept in the layout. */
+  draggable(g, task, at, configuration) {
+    const handle = g;
+    handle.addEventListener('pointerdown', (down) => {
+      if (down.button !== 0 || down.target.closest('.port')) return;
+      const origin = this.point(down);
+      let moving = false;
+      const move = (event) => {
+        const p = this.point(event);
+        if (!moving && Math.hypot(p.x - origin.x, p.y - origin.y) < DRAG_START) return;
+        moving = true;
+        g.classList.add('moving');
+        g.setAttribute('transform', `translate(${p.x - origin.x},${p.y - origin.y})`);
+      };
+      const up = (event) => {
+        handle.removeEventListener('pointermove', move);
+        handle.removeEventListener('pointerup', up);
+        if (!moving) return;
+        // The click that follows the release is the drag's, not a click on the task.
+        this.justMoved = true;
+        setTimeout(() => (this.justMoved = false), 0);
+        const p = this.point(event);
+        const snap = (v) => Math.round(v / SNAP) * SNAP;
+        this.layout.set(configuration, task.name, { x: snap(at.x + p.x - origin.x), y: snap(at.y + p.y - origin.y) });
+        this.redraw();
+      };
+      handle.setPointerCapture(down.pointerId);
+      handle.addEventListener('pointermove', move);
+      handle.addEventListener('pointerup', up);
+    });
+  }
+
+  box(task, at, state, bad, configuration) {
+    const g = svg('g', {
+      class: `task state-${(state || 'NOT-CREATED').replace(/\s/g, '-')}${at.moved ? ' moved' : ''}`,
+      'data-task': task.name,
+      'data-x': at.x,
+      'data-y': at.y,
+    });
     const period = task.period_ns === null ? 'aperiodic' : durationText(task.period_ns);
     g.append(
       svg('rect', { x: at.x, y: at.y, width: BOX_WIDTH, height: at.h, rx: 6, class: 'task-box' }),
       svg('text', { x: at.x + 10, y: at.y + 15, class: 'task-name' }, task.name),
       svg('text', { x: at.x + 10, y: at.y + 28, class: 'task-module' }, `${task.module} · ${period} · ${state || 'NOT-CREATED'}`),
     );
-    g.querySelector('rect').addEventListener('click', () => this.onTask && this.onTask(task));
+    // A click on the box, its name or its figures (a port's click is the port's: a rename).
+    g.addEventListener('click', (event) => !event.target.closest('.port') && !this.justMoved && this.onTask && this.onTask(task));
+    if (this.layout) this.draggable(g, task, at, configuration);
     const port = (p, i, left) => {
       const y = at.y + HEADER + i * ROW + ROW / 2;
       const x = left ? at.x : at.x + BOX_WIDTH;

@@ -190,6 +190,82 @@ test('assembles Figure 4 from an empty canvas, runs it, plots it and saves a fil
   }
 });
 
+/** The box of task `name` on the main canvas: where it is drawn, and whether it was moved by hand. */
+async function boxOf(page, name) {
+  return page.$eval(`#canvas g.task[data-task="${name}"]`, (g) => ({ x: Number(g.dataset.x), y: Number(g.dataset.y), moved: g.classList.contains('moved') }));
+}
+
+test('a task\'s parameters edited on the canvas, a refusal changing nothing; its box moved, and kept', async () => {
+  const run = startChimera(['serve', '--listen', '127.0.0.1:0'], 'edit');
+  const link = await run.link;
+  const { page, context, problems } = await openPage(link);
+  try {
+    await dragIn(page, 'robot_torque', 'robot', { criticality: 'soft' });
+    await dragIn(page, 'joint_traj_gen', 'traj', { criticality: 'soft', params: '{loop: true}' });
+    await dragIn(page, 'pid_joint', 'pid', { criticality: 'soft' });
+    await page.waitForFunction(() => document.querySelector('#verdict').textContent === 'legal');
+
+    // A value out of the parameter's range is refused with the loader's reason, and the task is
+    // back as it was: in the configuration, with its old parameters.
+    await page.click('#canvas g.task[data-task="traj"] rect');
+    await page.waitForSelector('#edit-task[data-task="traj"]');
+    // Every parameter as the task has it, the defaults filled in: the one given, and the others.
+    const shown = JSON.parse(await page.inputValue('#edit-params'));
+    assert.equal(shown.loop, true);
+    assert.equal(shown.segment_time, 1.5);
+    await page.fill('#edit-params', '{loop: true, segment_time: -1}');
+    await page.click('#edit-apply');
+    await page.waitForFunction(() => document.querySelector('#edit-error').textContent.includes('segment_time'));
+    await page.waitForFunction(() => document.querySelector('#verdict').textContent === 'legal');
+    assert.ok(await page.$('#canvas g.task[data-task="traj"]'), 'traj is back in the configuration');
+
+    // A good value: the task is added anew with it, and the saved file says so.
+    await page.click('#canvas g.task[data-task="traj"] rect');
+    await page.waitForSelector('#edit-task[data-task="traj"]');
+    await page.fill('#edit-params', '{loop: true, segment_time: 3}');
+    await page.fill('#edit-period', '2ms');
+    await page.click('#edit-apply');
+    await page.waitForFunction(() => document.querySelector('#edit-params') && document.querySelector('#edit-params').value.includes('"segment_time":3'));
+    await page.waitForFunction(() => document.querySelector('#verdict').textContent === 'legal');
+    await page.click('#save');
+    await page.waitForSelector('#save-dialog[open]');
+    const yaml = await page.inputValue('#save-text');
+    await page.click('#save-close');
+    assert.match(yaml, /segment_time: 3/, yaml);
+    assert.match(yaml, /name: traj[^\n]*\n(?:[^\n]*\n)*?\s+period: 2ms/, yaml);
+
+    // The box moved by hand: where it is let go (on the grid), the links following it; after a
+    // reload of the page it is still there; Auto layout puts it back.
+    const before = await boxOf(page, 'traj');
+    const rect = await page.$('#canvas g.task[data-task="traj"] rect');
+    const at = await rect.boundingBox();
+    await page.mouse.move(at.x + 20, at.y + 10);
+    await page.mouse.down();
+    await page.mouse.move(at.x + 30, at.y + 60, { steps: 5 });
+    await page.mouse.move(at.x + 40, at.y + 160, { steps: 5 });
+    await page.mouse.up();
+    await page.waitForSelector('#canvas g.task.moved[data-task="traj"]');
+    const moved = await boxOf(page, 'traj');
+    assert.ok(moved.y > before.y + 40, `moved down: ${JSON.stringify(before)} -> ${JSON.stringify(moved)}`);
+    assert.equal(moved.x % 10, 0);
+    assert.equal(moved.y % 10, 0);
+    assert.ok(await page.$('#canvas path.link[data-from="traj"][data-to="pid"][data-variable="theta_d"]'), 'the link follows the box');
+    await page.reload();
+    await page.waitForSelector('body[data-ready=true]', { timeout: 15000 });
+    await page.click('#configuration-tabs button[data-configuration="assembly"]');
+    await page.waitForSelector('#canvas g.task[data-task="traj"]');
+    assert.deepEqual(await boxOf(page, 'traj'), moved, 'the layout is kept by the browser');
+    await page.click('#auto-layout');
+    await page.waitForSelector('#canvas g.task[data-task="traj"]:not(.moved)');
+    assert.deepEqual(await boxOf(page, 'traj'), before);
+    await page.screenshot({ path: join(shots, 'onika-edit.png') });
+    assert.deepEqual(problems.filter((p) => !p.includes('status of 400')), []);
+  } finally {
+    await context.close();
+    assert.equal(await stopChimera(run), 0, run.stderr());
+  }
+});
+
 test('a task in ERROR shows its message and the clear button brings it back', async () => {
   const run = startChimera(['serve', '--listen', '127.0.0.1:0'], 'error');
   const link = await run.link;
