@@ -84,6 +84,19 @@ int run_module_process(const SubsystemSpec& spec, const Registry& registry, cons
     reply(sock, block.error());
     return 1;
   }
+  // A stray pointer of a module here may write its own tasks' variables, and nothing else of the
+  // table: every other variable's pages, and the directory's, are read-only in this process.
+  std::vector<VarIndex> writable;
+  for (const ResolvedTask& t : resolved.tasks) {
+    if (t.spec->process != args.process) continue;
+    for (const PortBinding& b : t.bindings)
+      if (b.kind == PortKind::kOutVar || b.kind == PortKind::kOutConst)
+        if (const auto v = table->find(b.variable)) writable.push_back(*v);
+  }
+  if (auto restricted = table->restrict_writes(writable); !restricted) {
+    reply(sock, restricted.error());
+    return 1;
+  }
   // Every task's shared part is the block's, as in the main process: its own tasks keep there what
   // the main process must see, and the others (never spawned here) what its producers wake them by.
   std::vector<TaskShared*> shared(resolved.tasks.size(), nullptr);

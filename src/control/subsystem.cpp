@@ -83,7 +83,12 @@ Result<void> Subsystem::Impl::build_runtime(const std::string& configuration, st
     return make_error(Errc::kIllegal, fmt::format("{}: configuration '{}' is not legal:\n{}", m.spec.file,
                                                   configuration, join_lines(violations)));
 
-  auto created = GlobalTable::create(m.spec.name + m.options.shm_suffix, fresh.subsystem.variables);
+  // With module processes each variable has pages of its own, so that a worker can be let write
+  // only its own tasks' (docs/processes.md).
+  const bool processes = m.options.clock == ClockKind::kReal && m.spec.uses_module_processes();
+  auto created =
+      GlobalTable::create(m.spec.name + m.options.shm_suffix, fresh.subsystem.variables,
+                          processes ? GlobalTable::Placement::kPagePerVariable : GlobalTable::Placement::kPacked);
   if (!created) return created.error();
   m.resolution = std::move(fresh);
   m.table = std::make_unique<GlobalTable>(std::move(*created));
@@ -99,7 +104,7 @@ Result<void> Subsystem::Impl::build_runtime(const std::string& configuration, st
   const ResolvedSubsystem& resolved = m.resolution.subsystem;
   // Module processes run on the real clock only: the virtual clock simulates every task on one thread.
   std::vector<TaskShared*> shared;
-  if (m.options.clock == ClockKind::kReal && m.spec.uses_module_processes()) {
+  if (processes) {
     // A worker loads the subsystem from its file (docs/processes.md): text has none to read.
     if (::access(m.spec.file.c_str(), R_OK) != 0)
       return make_error(Errc::kInvalidInput, fmt::format("{}: module processes (process:) need the subsystem loaded "

@@ -38,6 +38,9 @@ using Word = std::atomic_ref<std::uint64_t>;
 /// Largest payload of one variable; keeps byte counts in 32 bits everywhere.
 constexpr std::uint64_t kMaxVarBytes = std::uint64_t{1} << 28;
 
+/// The unit of memory protection (Placement::kPagePerVariable).
+std::uint64_t page_bytes() { return static_cast<std::uint64_t>(::sysconf(_SC_PAGESIZE)); }
+
 Error sys_error(std::string_view what, const std::string& shm) {
   return make_error(Errc::kSystem, fmt::format("{}({}) failed: {}", what, shm,
                                                std::error_code(errno, std::generic_category()).message()));
@@ -126,19 +129,25 @@ Result<void> check_layout(std::byte* base, std::uint64_t mapped, const std::stri
 
 }  // namespace
 
-Result<GlobalTable> GlobalTable::create(std::string_view subsystem_name, std::span<const VarSpec> vars) {
+Result<GlobalTable> GlobalTable::create(std::string_view subsystem_name, std::span<const VarSpec> vars,
+                                        Placement placement) {
   if (auto r = check_subsystem_name(subsystem_name); !r) return r.error();
   if (auto r = check_vars(vars); !r) return r.error();
   const std::string shm = fmt::format("/chimera_{}", subsystem_name);
 
-  // Layout first: the directory right after the header, then one 64-aligned block per variable.
-  const std::uint64_t dir_end = svt_detail::directory_offset() + vars.size() * sizeof(DirEntry);
-  std::uint64_t total = svt_detail::round_up(dir_end, svt_detail::kCacheLine);
+  // Layout first: the directory right after the header, then one 64-aligned block per variable;
+  // or, a page apart, the header alone on the first page, then the directory, then each block
+  // starting a page of its own.
+  const std::uint64_t unit = placement == Placement::kPagePerVariable ? page_bytes() : svt_detail::kCacheLine;
+  const std::uint64_t dir_offset =
+      placement == Placement::kPagePerVariable ? page_bytes() : svt_detail::directory_offset();
+  const std::uint64_t dir_end = dir_offset + vars.size() * sizeof(DirEntry);
+  std::uint64_t total = svt_detail::round_up(dir_end, unit);
   std::vector<std::uint64_t> block_offsets;
   block_offsets.reserve(vars.size());
   for (const VarSpec& var : vars) {
     block_offsets.push_back(total);
-    total += svt_detail::block_bytes(svt_detail::payload_words(var.shape.bytes()));
+    total = svt_detail::round_up(total + svt_detail::block_bytes(svt_detail::payload_words(var.shape.bytes())), unit);
   }
 
   // The region is made whole before it has a name: an unnamed file in /dev/shm, locked, its
@@ -187,10 +196,10 @@ Result<GlobalTable> GlobalTable::create(std::string_view subsystem_name, std::sp
   header->layout_version = svt_detail::kLayoutVersion;
   header->layout_fingerprint = svt_detail::kLayoutFingerprint;
   header->var_count = static_cast<std::uint32_t>(vars.size());
-  header->directory_offset = svt_detail::directory_offset();
+  header->directory_offset = dir_offset;
   header->total_size = total;
   for (std::size_t v = 0; v < vars.size(); ++v) {
-    auto* e = new (table.base_ + svt_detail::directory_offset() + v * sizeof(DirEntry)) DirEntry;
+    auto* e = new (table.base_ + dir_offset + v * sizeof(DirEntry)) DirEntry;
     std::memcpy(e->name.data(), vars[v].name.data(), vars[v].name.size());
     e->count = vars[v].shape.count;
     e->elem_type = static_cast<std::uint8_t>(vars[v].shape.type);
@@ -341,6 +350,30 @@ std::size_t GlobalTable::reclaim_stale(std::string_view name_prefix) {
     if (existing && existing->kind == svt_detail::Existing::Kind::kReclaimed) ++reclaimed;
   }
   return reclaimed;
+}
+
+Result<void> GlobalTable::restrict_writes(std::span<const VarIndex> writable) {
+  const auto* header = object_at<Header>(base_, 0);
+  const std::uint64_t page = page_bytes();
+  const auto refuse = [&](std::string_view why) {
+    return make_error(Errc::kInvalidInput, fmt::format("shared memory {}: cannot let this process write only its own "
+                                                       "variables: {}",
+                                                       shm_name_, why));
+  };
+  if (header->directory_offset % page != 0 || mapped_bytes_ % page != 0)
+    return refuse("it is not laid out a page apart");
+  for (VarIndex v = 0; v < header->var_count; ++v)
+    if (svt_detail::dir_entry(base_, v)->block_offset % page != 0) return refuse("a variable shares a page");
+  // Everything past the header page read-only, then each of its variables' pages writable again.
+  if (::mprotect(base_ + page, mapped_bytes_ - page, PROT_READ) != 0) return sys_error("mprotect", shm_name_);
+  for (const VarIndex v : writable) {
+    if (v >= header->var_count) return refuse(fmt::format("no variable {}", v));
+    const DirEntry* e = svt_detail::dir_entry(base_, v);
+    const std::uint64_t bytes = svt_detail::round_up(svt_detail::block_bytes(e->payload_words), page);
+    if (::mprotect(base_ + e->block_offset, bytes, PROT_READ | PROT_WRITE) != 0)
+      return sys_error("mprotect", shm_name_);
+  }
+  return {};
 }
 
 void GlobalTable::locate_blocks() {

@@ -66,21 +66,21 @@ std::uint64_t cycles_of(TaskBlock& block, std::size_t tasks) {
 TEST(NoAllocationInModuleProcess, Figure4InAWorkerOnTheRealClock) {
   auto spec = load_subsystem_file(CHIMERA_EXAMPLES_DIR "/fig4_pid_joint.yaml", Registry::global());
   ASSERT_TRUE(spec.ok()) << spec.error().message;
-  // The table, its constants written, made by a subsystem that is never started: the owner a
-  // worker attaches to. The worker's copy of the file puts every task in its process.
-  RunOptions options;
-  options.shm_suffix = testing::unique_suffix();
-  options.realtime_priorities = false;
-  auto owner = Subsystem::create(*spec, Registry::global(), options);
-  ASSERT_TRUE(owner.ok()) << owner.error().message;
+  // The file with every task in one module process. Soft: a deadline a loaded machine makes them
+  // miss must not end their cycling (ERROR); the subject here is allocation, not timing.
   SubsystemSpec in_worker = *spec;
-  // Soft: a deadline a loaded machine makes them miss must not end their cycling (ERROR); the
-  // subject here is allocation, not timing.
   for (auto& t : in_worker.tasks) {
     t.process = "arm";
     t.criticality = Criticality::kSoft;
   }
   const std::size_t n = in_worker.tasks.size();
+  // The table, its constants written and laid out a page apart as for module processes, made by a
+  // subsystem that is never started: the owner the worker attaches to.
+  RunOptions options;
+  options.shm_suffix = testing::unique_suffix();
+  options.realtime_priorities = false;
+  auto owner = Subsystem::create(in_worker, Registry::global(), options);
+  ASSERT_TRUE(owner.ok()) << owner.error().message;
 
   auto block = TaskBlock::create(n);
   ASSERT_TRUE(block.ok()) << block.error().message;

@@ -32,13 +32,19 @@ struct ReadOutcome {
 
 class GlobalTable {
  public:
+  /// Where the variables' blocks go: packed one after the other (each on its own cache lines),
+  /// or each on pages of its own, after a header page and the directory's pages, so that a
+  /// process can be let write only its own variables (restrict_writes(): module processes).
+  enum class Placement : std::uint8_t { kPacked, kPagePerVariable };
+
   /// Creates the region /chimera_<name> (mode 0600) and lays out `vars`, its memory reserved up
   /// front: a full /dev/shm is an error saying so, never a SIGBUS later. The returned owner
   /// holds a lock on the region while it lives and unlinks it when destroyed. A region of the
   /// same name whose lock nobody holds is stale (its creator is gone, however it ended and
   /// whatever became of its pid) and is replaced; one whose owner lives is refused. Not
   /// real-time safe.
-  static Result<GlobalTable> create(std::string_view subsystem_name, std::span<const VarSpec> vars);
+  static Result<GlobalTable> create(std::string_view subsystem_name, std::span<const VarSpec> vars,
+                                    Placement placement = Placement::kPacked);
   /// Removes the name of every region this process created and still owns, each only if the name
   /// is still that region's: for a signal handler about to end the process the abrupt way, so
   /// that no region is left behind. The mappings stay valid. Async-signal-safe.
@@ -58,6 +64,12 @@ class GlobalTable {
   GlobalTable(const GlobalTable&) = delete;
   GlobalTable& operator=(const GlobalTable&) = delete;
   ~GlobalTable();
+
+  /// Makes this process's mapping read-only but for the header page (the illegal-configuration
+  /// flag, which any task may raise) and the blocks of `writable`: a write anywhere else, a stray
+  /// pointer's, faults in this process instead of changing another writer's variable or the
+  /// directory. Refused for a region not laid out kPagePerVariable. Not real-time safe.
+  [[nodiscard]] Result<void> restrict_writes(std::span<const VarIndex> writable);
 
   /// Name of the shared memory object, e.g. "/chimera_fig4".
   [[nodiscard]] const std::string& shm_name() const { return shm_name_; }

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <sstream>
 #include <string>
@@ -98,18 +99,23 @@ bool run_until(Subsystem& s, Done done) {
   return false;
 }
 
+// A sanitizer's own SIGSEGV handler would report and exit with its code: in a sanitized build
+// the workers still die of the signal, as in a plain one. Read by the workers only (this process
+// read its options at start).
+void let_workers_die_of_segv() {
+  for (const char* var : {"ASAN_OPTIONS", "TSAN_OPTIONS"}) {
+    const char* now = std::getenv(var);  // NOLINT(concurrency-mt-unsafe): before any worker or thread
+    if (now != nullptr && std::strstr(now, "handle_segv=0") != nullptr) continue;
+    const std::string value =
+        (now != nullptr && *now != '\0' ? std::string(now) + ":" : std::string()) + "handle_segv=0";
+    ::setenv(var, value.c_str(), 1);  // NOLINT(concurrency-mt-unsafe): as above
+  }
+}
+
 class ModuleProcessTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    // A sanitizer's own SIGSEGV handler would report and exit with its code: in a sanitized
-    // build the workers still die of the signal, as in a plain one. Read by the workers only
-    // (this process read its options at start).
-    for (const char* var : {"ASAN_OPTIONS", "TSAN_OPTIONS"}) {
-      const char* now = std::getenv(var);  // NOLINT(concurrency-mt-unsafe): before any worker or thread
-      const std::string value =
-          (now != nullptr && *now != '\0' ? std::string(now) + ":" : std::string()) + "handle_segv=0";
-      ::setenv(var, value.c_str(), 1);  // NOLINT(concurrency-mt-unsafe): as above
-    }
+    let_workers_die_of_segv();
     const std::string path = dir_.file("fig4_processes.yaml");
     test::write_text(path, file_text(dir_));
     RunOptions options;
@@ -390,6 +396,46 @@ TEST(ModuleProcessPrecedence, AConsumerReadsItsProducersValueOfTheSameReleaseAcr
       << "of " << check.stats.cycles << " releases, " << (*mismatches)[0] << " read another release's stamp and "
       << check.stats.order_timeouts << " gave up waiting for it";
   EXPECT_LT(check.stats.order_timeouts, check.stats.cycles / 2) << "the rule gave up on most releases";
+}
+
+// A stray pointer in a module process writes only where its own tasks write: the table's other
+// variables' pages are read-only there. A module that writes over the whole table (each byte as
+// it was) dies of SIGSEGV at the first page not its own, its task ERROR; Figure 4's loop beside it
+// runs on. Where every page was writable it would write them all and live on.
+TEST(ModuleProcessIsolation, AStrayWriteToAnotherWritersVariableFaultsInItsOwnProcess) {
+  let_workers_die_of_segv();
+  TempDir dir;
+  const std::string path = dir.file("stray.yaml");
+  test::write_text(path,
+                   "subsystem: stray\n"
+                   "plugins: [" FAULTY_PLUGIN
+                   "]\n"
+                   "tasks:\n"
+                   "  - {name: traj, module: joint_traj_gen, period: 1ms, criticality: soft}\n"
+                   "  - {name: pid, module: pid_joint, period: 1ms, criticality: soft}\n"
+                   "  - {name: robot, module: robot_torque, period: 1ms, criticality: soft}\n"
+                   "  - {name: stray, module: scribbles_on_the_table, period: 2ms, criticality: soft,"
+                   " process: wild, params: {after: 25}}\n");
+  const auto started = test::started_subsystem(path);
+  ASSERT_NE(started, nullptr);
+  Subsystem& s = *started;
+  ASSERT_TRUE(run_until(s, [](const auto& all) { return task_of(all, "stray").state == TaskState::kError; }))
+      << "the stray writes went through: every page of the table was writable in its process";
+  const auto at_fault = s.snapshot();
+  EXPECT_NE(task_of(at_fault, "stray").last_error.find("its process wild died (killed by SIGSEGV"), std::string::npos)
+      << task_of(at_fault, "stray").last_error;
+  const auto grew = [&](const std::vector<TaskSnapshot>& now) {
+    for (const char* name : {"traj", "pid", "robot"})
+      if (task_of(now, name).stats.cycles <= task_of(at_fault, name).stats.cycles + 100) return false;
+    return true;
+  };
+  EXPECT_TRUE(run_until(s, grew));
+  for (const char* name : {"traj", "pid", "robot"})
+    EXPECT_EQ(task_of(s.snapshot(), name).state, TaskState::kOn) << name;
+  auto ndof = s.get("ndof");
+  ASSERT_TRUE(ndof.ok()) << ndof.error().message;
+  EXPECT_EQ((*ndof)[0], 6.0);
+  s.stop();
 }
 
 }  // namespace

@@ -8,8 +8,12 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <array>
 #include <csignal>
+#include <cstdint>
+#include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <string>
 
 #include <chimera/module/registry.hpp>
@@ -224,6 +228,56 @@ class ChecksStamp final : public chimera::Module {
   const chimera::CycleTiming* timing_ = nullptr;
 };
 
+// A stray pointer: at its cycle `after` it writes into every page of its process's mapping of the
+// subsystem's table, the last page first, each byte written as it was read. In a module process
+// only its own variable's pages (and the header's) take a write: the first other page ends the
+// process with SIGSEGV. Its out-var counts the pages written.
+class ScribblesOnTheTable final : public chimera::Module {
+ public:
+  static constexpr const char* kName = "scribbles_on_the_table";
+  static constexpr const char* kSummary = "writes over the whole state variable table (a test of module processes)";
+  static constexpr const char* kDoc = "At cycle `after`, writes into every page of its mapping of the table.";
+  static void declare(chimera::Declarations& d, const chimera::Params& /*params*/) {
+    d.out_var("pages_scribbled", chimera::Dim::fixed(1), "pages of the table it wrote into");
+    d.param("after", 20.0, "", "the cycle that scribbles");
+  }
+
+ protected:
+  chimera::Status init(chimera::InitContext& ctx) override {
+    pages_ = ctx.out<double>("pages_scribbled");
+    after_ = static_cast<long>(ctx.params().number("after", 20.0));
+    return chimera::Status::ok();
+  }
+  chimera::Status cycle() override {
+    if (++cycles_ != after_) return chimera::Status::ok();
+    // The table's mapping, found as a stray pointer would find it: by what it is named.
+    std::FILE* maps = std::fopen("/proc/self/maps", "r");
+    if (maps == nullptr) return chimera::Status::fail("no /proc/self/maps");
+    std::array<char, 512> line{};
+    std::uintptr_t begin = 0;
+    std::uintptr_t end = 0;
+    while (std::fgets(line.data(), static_cast<int>(line.size()), maps) != nullptr)
+      if (std::strstr(line.data(), "/dev/shm/chimera_") != nullptr)
+        (void)std::sscanf(line.data(), "%lx-%lx", &begin, &end);  // NOLINT(cert-err34-c): a test's parse
+    std::fclose(maps);
+    if (begin == 0) return chimera::Status::fail("no table mapped");
+    const std::uintptr_t page = static_cast<std::uintptr_t>(::sysconf(_SC_PAGESIZE));
+    for (std::uintptr_t at = end - page; at >= begin; at -= page) {
+      // NOLINTNEXTLINE(performance-no-int-to-ptr): the stray pointer under test
+      volatile char* p = reinterpret_cast<char*>(at);
+      *p = *p;
+      pages_[0] += 1.0;
+      if (at == begin) break;
+    }
+    return chimera::Status::ok();
+  }
+
+ private:
+  chimera::Out<double> pages_;
+  long after_ = 20;
+  long cycles_ = 0;
+};
+
 }  // namespace
 
 CHIMERA_REGISTER_MODULE(SegfaultInCycle);
@@ -235,3 +289,4 @@ CHIMERA_REGISTER_MODULE(AsksForSwitch);
 CHIMERA_REGISTER_MODULE(CountsUpdates);
 CHIMERA_REGISTER_MODULE(ReleaseStamp);
 CHIMERA_REGISTER_MODULE(ChecksStamp);
+CHIMERA_REGISTER_MODULE(ScribblesOnTheTable);
