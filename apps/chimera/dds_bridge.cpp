@@ -7,15 +7,11 @@
 
 namespace chimera::cli {
 
-DdsBridge::DdsBridge(const SubsystemSpec& spec, Subsystem& subsystem, std::string table_name)
-    : spec_(spec), subsystem_(subsystem), table_name_(std::move(table_name)) {}
+DdsBridge::DdsBridge(Subsystem& subsystem, std::string shm_suffix)
+    : subsystem_(subsystem), shm_suffix_(std::move(shm_suffix)) {}
 
-Result<std::unique_ptr<DdsBridge>> DdsBridge::start(const SubsystemSpec& spec, Subsystem& subsystem,
-                                                    std::string table_name) {
-  std::unique_ptr<DdsBridge> bridge(new DdsBridge(spec, subsystem, std::move(table_name)));
-  for (const auto& x : spec.exports)
-    if (auto watched = subsystem.watch_writes(x.variable, bridge->exports_written_); !watched)
-      spdlog::warn("dds: export {}: {}; it is polled", x.variable, watched.error().message);
+Result<std::unique_ptr<DdsBridge>> DdsBridge::start(Subsystem& subsystem, std::string shm_suffix) {
+  std::unique_ptr<DdsBridge> bridge(new DdsBridge(subsystem, std::move(shm_suffix)));
   if (auto attached = bridge->attach(); !attached) return attached.error();
   return bridge;
 }
@@ -24,9 +20,19 @@ Result<void> DdsBridge::attach() {
   // Read before attaching: a rebuild after this read is seen at the next poll.
   runtimes_seen_ = subsystem_.runtimes_built();
   ports_.reset();  // the old bridge leaves the domain (and the old region) before the new one joins
+  const SubsystemSpec spec = subsystem_.spec();
+  // The subsystem keeps a watch across rebuilds: each variable is registered once.
+  for (const auto& x : spec.exports) {
+    if (watched_.contains(x.variable)) continue;
+    if (auto watched = subsystem_.watch_writes(x.variable, exports_written_); !watched)
+      spdlog::warn("dds: export {}: {}; it is polled", x.variable, watched.error().message);
+    else
+      watched_.insert(x.variable);
+  }
+  if (!spec.has_remote_variables()) return {};
   RemotePortsOptions options;
   options.exports_written = exports_written_;
-  auto ports = RemotePorts::create(spec_, table_name_, std::move(options));
+  auto ports = RemotePorts::create(spec, spec.name + shm_suffix_, std::move(options));
   if (!ports) return ports.error();
   ports_ = std::move(*ports);
   return {};
@@ -35,11 +41,14 @@ Result<void> DdsBridge::attach() {
 std::vector<std::string> DdsBridge::poll() {
   std::vector<std::string> lines;
   if (subsystem_.runtimes_built() != runtimes_seen_) {
-    if (ports_ != nullptr)
+    const bool bridged = ports_ != nullptr;
+    if (bridged)
       for (auto& line : ports_->take_errors()) lines.push_back(std::move(line));
-    if (auto attached = attach(); attached)
-      lines.emplace_back("the table was made anew (a task added): the bridge follows it");
-    else
+    if (auto attached = attach(); attached && ports_ != nullptr)
+      lines.emplace_back("the table was made anew (a task added, or a file opened): the bridge follows it");
+    else if (attached && bridged)
+      lines.emplace_back("the subsystem has no exports or imports now: the bridge stops");
+    else if (!attached)
       lines.push_back(
           fmt::format("the table was made anew and the bridge could not follow it: {}; imports and exports stop",
                       attached.error().message));

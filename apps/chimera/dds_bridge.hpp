@@ -1,12 +1,15 @@
 #pragma once
 // The run's bridge to other subsystems over DDS (docs/dds.md): RemotePorts attached to the
 // subsystem's table, its publisher woken by the exports' producers. The live assembly's add
-// makes the table anew (a new region under the same name); the bridge follows it there, or its
+// makes the table anew (a new region under the same name), and opening another file makes it
+// anew for that file (its name, its exports and imports): the bridge follows it there, or its
 // exports would go on publishing the old region's last values and its imports be written where
-// no task reads them.
+// no task reads them. A subsystem without exports or imports has the bridge idle, ready for a
+// file that has some.
 
 #include <cstdint>
 #include <memory>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -20,25 +23,28 @@ namespace chimera::cli {
 
 class DdsBridge {
  public:
-  /// Attaches to `subsystem`'s table (`table_name`: its name and shm suffix) and starts the
-  /// bridge for `spec`'s imports and exports; refused as RemotePorts::create refuses.
-  static Result<std::unique_ptr<DdsBridge>> start(const SubsystemSpec& spec, Subsystem& subsystem,
-                                                  std::string table_name);
+  /// Starts the bridge for the imports and exports of `subsystem`'s file (none: idle), attached
+  /// to its table (named after the file's subsystem and `shm_suffix`); refused as
+  /// RemotePorts::create refuses.
+  static Result<std::unique_ptr<DdsBridge>> start(Subsystem& subsystem, std::string shm_suffix);
 
   /// What the bridge has to say (an import stale or fresh again, a remote refused), one line each
   /// without "dds: "; first, if the table was made anew since the last call, the bridge is started
-  /// again on the new one (and says so, or why it could not be). Call it from the run's loop.
+  /// again on the new one for the subsystem's file as it is now (and says so, or why it could not
+  /// be). Call it from the run's loop, where nothing changes the subsystem meanwhile (the gate).
   std::vector<std::string> poll();
   /// The bridge's last errors; then it stops (it writes no import after this).
   std::vector<std::string> stop();
 
  private:
-  DdsBridge(const SubsystemSpec& spec, Subsystem& subsystem, std::string table_name);
+  DdsBridge(Subsystem& subsystem, std::string shm_suffix);
+  /// The subsystem's file as it is now: its exports watched, then RemotePorts for its imports and
+  /// exports made anew (none when it has neither).
   Result<void> attach();
 
-  SubsystemSpec spec_;
   Subsystem& subsystem_;
-  std::string table_name_;
+  std::string shm_suffix_;
+  std::set<std::string> watched_;  // the exports registered with the subsystem's watch
   // Registered once with the subsystem, which keeps it across rebuilds: every RemotePorts the
   // bridge makes waits on the same one.
   std::shared_ptr<WriteWatch> exports_written_ = std::make_shared<WriteWatch>();

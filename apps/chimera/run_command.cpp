@@ -130,9 +130,12 @@ class Session {
 
   void print_events(bool& prompt_shown) {
     std::string events = control_.drain_events();
-    // The bridge's news among the subsystem's own: an import stale or back, a remote refused.
+    // The bridge's news among the subsystem's own: an import stale or back, a remote refused. It
+    // reads the subsystem's file when the table was made anew: under the gate, so that no
+    // command changes the file meanwhile.
     if (remote_ != nullptr)
-      for (const auto& line : remote_->poll()) events += "dds: " + line + "\n";
+      for (const auto& line : control_.exclusive([&](Control&, Subsystem&) { return remote_->poll(); }))
+        events += "dds: " + line + "\n";
     if (events.empty()) return;
     // Keep the operator's prompt usable: events go on their own lines, then the prompt again.
     if (prompt_shown) out("\n");
@@ -217,10 +220,11 @@ int run_command(const RunArgs& args) {
     return kExitInvalid;
   }
 
-  // The resource ports to other subsystems: on their own ordinary threads, attached to the table.
+  // The resource ports to other subsystems: on their own ordinary threads, attached to the table;
+  // idle until a file with exports or imports runs (this one, or one opened later).
   std::unique_ptr<DdsBridge> remote;
-  if (spec->has_remote_variables()) {
-    auto bridge = DdsBridge::start(*spec, subsystem, spec->name + options.shm_suffix);
+  {
+    auto bridge = DdsBridge::start(subsystem, options.shm_suffix);
     if (!bridge) {
       fmt::print(stderr, "{}: dds: {}\n", spec->file, bridge.error().message);
       subsystem.stop();

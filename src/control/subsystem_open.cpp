@@ -19,11 +19,8 @@ Result<void> Subsystem::replace(SubsystemSpec next) {
   {
     std::lock_guard<std::mutex> lock(m.ops_mutex);
     if (m.stopped) return make_error(Errc::kState, "the subsystem is stopped");
-    // The bridge is made once, for the exports and imports of the file the run started with.
-    if (m.spec.has_remote_variables() || next.has_remote_variables())
-      return make_error(Errc::kState,
-                        "open: not with exports or imports (DDS): chimera run FILE bridges the file it "
-                        "starts with only");
+    // Exports and imports are the run's bridge's (apps/chimera/dds_bridge.hpp), which follows
+    // the table made anew for the file to the file's exports and imports.
   }
   if (auto cpus = check_task_cpus(next); !cpus) return make_error(Errc::kInvalidInput, "open: " + cpus.error().message);
   {

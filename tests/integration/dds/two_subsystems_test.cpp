@@ -308,6 +308,45 @@ TEST(TwoSubsystems, TheBridgeFollowsTheTableThatAnAddMadeAnew) {
   EXPECT_EQ(robot.process->wait_exit(), 0) << robot.err();
 }
 
+// A run that starts without exports or imports, and opens the robot side's file: the bridge,
+// idle until then, bridges that file's (x_d from the vision side arrives, x_m reaches it), under
+// the opened file's subsystem name; opening a file without any stops it again.
+TEST(TwoSubsystems, AFileOpenedWithImportsIsBridged) {
+  const Names names;
+  const std::string plain = "subsystem: plain_" + std::to_string(::getpid()) +
+                            "\ntasks:\n  - {name: idle, module: cpu_load, period: 10ms, criticality: soft}\n";
+  Side robot("plain", plain, {});
+  const std::string robot_path = robot.dir.file(names.robot + ".yaml");
+  write_text(robot_path, robot_file(names));
+  Side vision(names.vision, vision_file(names), {});
+  robot.process->send("open " + robot_path + "\n");
+  ASSERT_TRUE(eventually([&] {
+    return robot.err().find("dds: import x_d: first sample, from subsystem " + names.vision + "\n") !=
+           std::string::npos;
+  })) << robot.err()
+      << robot.process->out();
+  EXPECT_NE(robot.err().find("dds: the table was made anew (a task added, or a file opened): the bridge follows it"),
+            std::string::npos)
+      << robot.err();
+  // The other way: x_m from the opened file's forward kinematics reaches the vision side.
+  EXPECT_TRUE(eventually([&] { return Side::values(vision.get("x_m")) != std::vector<double>(6, 0.0); }))
+      << vision.get("x_m") << vision.err();
+
+  const std::string plain_again = robot.dir.file("plain_again.yaml");
+  write_text(plain_again, plain);
+  robot.process->send("open " + plain_again + "\n");
+  EXPECT_TRUE(eventually([&] {
+    return robot.err().find("dds: the subsystem has no exports or imports now: the bridge stops") != std::string::npos;
+  })) << robot.err();
+  EXPECT_TRUE(eventually([&] { return vision.err().find("dds: import x_m: stale") != std::string::npos; }))
+      << vision.err();
+
+  vision.process->send("quit\n");
+  EXPECT_EQ(vision.process->wait_exit(), 0) << vision.err();
+  robot.process->send("quit\n");
+  EXPECT_EQ(robot.process->wait_exit(), 0) << robot.err();
+}
+
 TEST(TwoSubsystems, TheRobotSideHoldsWhileTheVisionSideIsAwayOnOneNetworkStack) {
   robot_holds_while_vision_is_away({}, {}, nullptr);
 }
