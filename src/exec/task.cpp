@@ -271,8 +271,8 @@ void Task::set_state(TaskState s) noexcept {
     shared_->ever_in_error.store(true, std::memory_order_relaxed);  // a latch, read on its own
     table_.raise_illegal_configuration();
   }
-  shared_->state.store(s,
-                       std::memory_order_release);  // release: what the method did is visible to whoever sees the state
+  // Release: what the method did is visible to whoever sees the state.
+  shared_->state.store(s, std::memory_order_release);
   if (before == TaskState::kError && s != TaskState::kError) table_.lower_illegal_configuration();
 }
 
