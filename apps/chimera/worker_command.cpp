@@ -2,7 +2,7 @@
 // [--no-realtime] [--cpu-time] [--rt-check] [--history-fd N --record-seconds S] [--bell TASK:FD ...]: a module process
 // (docs/processes.md). Not for people: the main process of `chimera run` starts it, and it is left out of the help.
 
-#include <cstdio>
+#include <charconv>
 #include <cstdlib>
 #include <string>
 #include <vector>
@@ -47,10 +47,13 @@ int worker_command(int argc, char** argv) {
   args.realtime_priorities = !no_realtime;
   args.record_seconds = std::strtod(record_seconds.c_str(), nullptr);
   for (const std::string& bell : bells) {
-    unsigned long task = 0;
+    std::size_t task = 0;
     int fd = -1;
-    if (std::sscanf(bell.c_str(), "%lu:%d", &task, &fd) != 2)
-      return kExitInvalid;  // NOLINT(cert-err34-c): both checked by the count
+    const char* end = bell.data() + bell.size();
+    const auto [colon, task_error] = std::from_chars(bell.data(), end, task);
+    if (task_error != std::errc() || colon == end || *colon != ':') return kExitInvalid;
+    if (const auto [rest, fd_error] = std::from_chars(colon + 1, end, fd); fd_error != std::errc() || rest != end)
+      return kExitInvalid;
     args.bells.emplace_back(task, fd);
   }
   if (config_opt->count() > 0) args.configuration = config;

@@ -68,6 +68,48 @@ Result<void> carry_out(Executive& executive, const ProcessCommand& c, const std:
   return {};
 }
 
+// The variables the tasks of `process` produce (out-vars and out-consts): all it may write.
+std::vector<VarIndex> written_by(const ResolvedSubsystem& resolved, const GlobalTable& table,
+                                 const std::string& process) {
+  std::vector<VarIndex> written;
+  for (const ResolvedTask& t : resolved.tasks) {
+    if (t.spec->process != process) continue;
+    for (const PortBinding& b : t.bindings)
+      if (b.kind == PortKind::kOutVar || b.kind == PortKind::kOutConst)
+        if (const auto v = table.find(b.variable)) written.push_back(*v);
+  }
+  return written;
+}
+
+// The main process's commands, until it says quit (0) or is gone (the process ends at once).
+int serve_commands(int sock, Executive& executive, const std::vector<bool>& mine, const ResolvedSubsystem& resolved,
+                   pthread_mutex_t* life) {
+  for (;;) {
+    ProcessCommand c;
+    const ssize_t got = ::recv(sock, &c, sizeof c, 0);
+    if (got == 0 || (got < 0 && errno != EINTR)) {
+      // The main process is gone (EOF): nobody will read the tasks' figures or send them off.
+      // End at once, so that a crashed main process never leaves a worker running on.
+      std::_Exit(0);
+    }
+    if (got != static_cast<ssize_t>(sizeof c)) continue;
+    if (c.kind == ProcessCommandKind::kQuit) {
+      executive.shutdown();
+      // Given back by hand: the block is unmapped on the way out, and the kernel can release a
+      // robust lock only where it is still mapped.
+      if (life != nullptr) pthread_mutex_unlock(life);
+      reply(sock, Result<void>{});
+      return 0;
+    }
+    if (c.kind == ProcessCommandKind::kCommit) {
+      const CommitOutcome outcome = commit(executive, c, mine, resolved);
+      reply(sock, outcome.fault, outcome.joins_from_ns);
+      continue;
+    }
+    reply(sock, carry_out(executive, c, mine));
+  }
+}
+
 }  // namespace
 
 int run_module_process(const SubsystemSpec& spec, const Registry& registry, const ModuleProcessArgs& args) {
@@ -86,14 +128,7 @@ int run_module_process(const SubsystemSpec& spec, const Registry& registry, cons
   }
   // A stray pointer of a module here may write its own tasks' variables, and nothing else of the
   // table: every other variable's pages, and the directory's, are read-only in this process.
-  std::vector<VarIndex> writable;
-  for (const ResolvedTask& t : resolved.tasks) {
-    if (t.spec->process != args.process) continue;
-    for (const PortBinding& b : t.bindings)
-      if (b.kind == PortKind::kOutVar || b.kind == PortKind::kOutConst)
-        if (const auto v = table->find(b.variable)) writable.push_back(*v);
-  }
-  if (auto restricted = table->restrict_writes(writable); !restricted) {
+  if (auto restricted = table->restrict_writes(written_by(resolved, *table, args.process)); !restricted) {
     reply(sock, restricted.error());
     return 1;
   }
@@ -157,31 +192,7 @@ int run_module_process(const SubsystemSpec& spec, const Registry& registry, cons
     if (pthread_mutex_lock(life) == EOWNERDEAD) pthread_mutex_consistent(life);  // a previous start's
   }
   reply(sock, Result<void>{});  // ready
-
-  for (;;) {
-    ProcessCommand c;
-    const ssize_t got = ::recv(sock, &c, sizeof c, 0);
-    if (got == 0 || (got < 0 && errno != EINTR)) {
-      // The main process is gone (EOF): nobody will read the tasks' figures or send them off.
-      // End at once, so that a crashed main process never leaves a worker running on.
-      std::_Exit(0);
-    }
-    if (got != static_cast<ssize_t>(sizeof c)) continue;
-    if (c.kind == ProcessCommandKind::kQuit) {
-      executive->shutdown();
-      // Given back by hand: the block is unmapped on the way out, and the kernel can release a
-      // robust lock only where it is still mapped.
-      if (life != nullptr) pthread_mutex_unlock(life);
-      reply(sock, Result<void>{});
-      return 0;
-    }
-    if (c.kind == ProcessCommandKind::kCommit) {
-      const CommitOutcome outcome = commit(*executive, c, mine, resolved);
-      reply(sock, outcome.fault, outcome.joins_from_ns);
-      continue;
-    }
-    reply(sock, carry_out(*executive, c, mine));
-  }
+  return serve_commands(sock, *executive, mine, resolved, life);
 }
 
 }  // namespace chimera

@@ -200,6 +200,7 @@ std::int64_t Worker::run_job(std::int64_t release_abs) {
   return used;
 }
 
+// NOLINTNEXTLINE(readability-make-member-function-const): it publishes the release it is about to run (precedence)
 std::int64_t Worker::prepare() {
   if (schedule.on_at >= 0) return exec->epoch_ns() + schedule.on_at * task->period_ns();  // a switch: on then
   if (task->state() != TaskState::kOn) {

@@ -36,6 +36,12 @@ struct alignas(64) Header {
 };
 static_assert(std::atomic<std::int64_t>::is_always_lock_free);
 
+// The header at the start of a mapped block: the one place its bytes are taken for it.
+Header* header_of(std::byte* base) noexcept {
+  return std::launder(reinterpret_cast<Header*>(
+      base));  // NOLINT(cppcoreguidelines-pro-type-reinterpret-cast): a mapping's bytes, laid out by create()
+}
+
 constexpr std::size_t kSlotsOffset =
     (sizeof(Header) + alignof(TaskShared) - 1) / alignof(TaskShared) * alignof(TaskShared);
 
@@ -92,7 +98,7 @@ Result<TaskBlock> TaskBlock::attach(int fd, std::size_t tasks) {
   void* p = ::mmap(nullptr, b.bytes_, PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
   if (p == MAP_FAILED) return sys_error("mmap");
   b.base_ = static_cast<std::byte*>(p);
-  const auto* header = std::launder(reinterpret_cast<const Header*>(b.base_));
+  const Header* header = header_of(b.base_);
   if (header->magic != kMagic || header->layout != kLayout || header->tasks != tasks)
     return make_error(Errc::kSystem, "the task block was made by another build of Chimera (its layout differs)");
   return b;
@@ -128,20 +134,18 @@ TaskShared* TaskBlock::slot(std::size_t task) const noexcept {
   return std::launder(reinterpret_cast<TaskShared*>(base_ + kSlotsOffset + task * sizeof(TaskShared)));
 }
 
-pthread_mutex_t* TaskBlock::life(std::size_t process) const noexcept {
-  return &std::launder(reinterpret_cast<Header*>(base_))->life[process];
-}
+pthread_mutex_t* TaskBlock::life(std::size_t process) const noexcept { return &header_of(base_)->life[process]; }
 
-Doorbell& TaskBlock::requests_bell() const noexcept { return std::launder(reinterpret_cast<Header*>(base_))->requests; }
+Doorbell& TaskBlock::requests_bell() const noexcept { return header_of(base_)->requests; }
 
 std::int64_t TaskBlock::epoch_ns() const noexcept {
   // Acquire: pairs with set_epoch_ns, written before any worker starts.
-  return std::launder(reinterpret_cast<const Header*>(base_))->epoch_ns.load(std::memory_order_acquire);
+  return header_of(base_)->epoch_ns.load(std::memory_order_acquire);
 }
 
 void TaskBlock::set_epoch_ns(std::int64_t epoch_ns) noexcept {
   // Release: a worker that reads it also sees the slots as they were made.
-  std::launder(reinterpret_cast<Header*>(base_))->epoch_ns.store(epoch_ns, std::memory_order_release);
+  header_of(base_)->epoch_ns.store(epoch_ns, std::memory_order_release);
 }
 
 }  // namespace chimera
