@@ -38,21 +38,24 @@ Result<void> DdsBridge::attach() {
   return {};
 }
 
-std::vector<std::string> DdsBridge::poll() {
+std::vector<std::string> DdsBridge::follow() {
   std::vector<std::string> lines;
-  if (subsystem_.runtimes_built() != runtimes_seen_) {
-    const bool bridged = ports_ != nullptr;
-    if (bridged)
-      for (auto& line : ports_->take_errors()) lines.push_back(std::move(line));
-    if (auto attached = attach(); attached && ports_ != nullptr)
-      lines.emplace_back("the table was made anew (a task added, or a file opened): the bridge follows it");
-    else if (attached && bridged)
-      lines.emplace_back("the subsystem has no exports or imports now: the bridge stops");
-    else if (!attached)
-      lines.push_back(
-          fmt::format("the table was made anew and the bridge could not follow it: {}; imports and exports stop",
-                      attached.error().message));
-  }
+  const bool bridged = ports_ != nullptr;
+  if (bridged)
+    for (auto& line : ports_->take_errors()) lines.push_back(std::move(line));
+  if (auto attached = attach(); attached && ports_ != nullptr)
+    lines.emplace_back("the table was made anew (a task added, or a file opened): the bridge follows it");
+  else if (attached && bridged)
+    lines.emplace_back("the subsystem has no exports or imports now: the bridge stops");
+  else if (!attached)
+    lines.push_back(
+        fmt::format("the table was made anew and the bridge could not follow it: {}; imports and exports stop",
+                    attached.error().message));
+  return lines;
+}
+
+std::vector<std::string> DdsBridge::news() {
+  std::vector<std::string> lines;
   if (ports_ == nullptr) return lines;
   for (auto& line : ports_->take_errors()) lines.push_back(std::move(line));
   for (auto& line : ports_->take_changes()) lines.push_back(std::move(line));

@@ -28,11 +28,15 @@ class DdsBridge {
   /// RemotePorts::create refuses.
   static Result<std::unique_ptr<DdsBridge>> start(Subsystem& subsystem, std::string shm_suffix);
 
+  /// Whether the table was made anew since the bridge last attached (a task added, a file opened).
+  [[nodiscard]] bool table_made_anew() const { return subsystem_.runtimes_built() != runtimes_seen_; }
+  /// The bridge started again on the new table, for the subsystem's file as it is now; what it has
+  /// to say of that, one line each without "dds: ". Call it where nothing changes the subsystem
+  /// meanwhile (the run's loop, holding the gate).
+  std::vector<std::string> follow();
   /// What the bridge has to say (an import stale or fresh again, a remote refused), one line each
-  /// without "dds: "; first, if the table was made anew since the last call, the bridge is started
-  /// again on the new one for the subsystem's file as it is now (and says so, or why it could not
-  /// be). Call it from the run's loop, where nothing changes the subsystem meanwhile (the gate).
-  std::vector<std::string> poll();
+  /// without "dds: ". Any time; the run's loop asks every 50 ms.
+  std::vector<std::string> news();
   /// The bridge's last errors; then it stops (it writes no import after this).
   std::vector<std::string> stop();
 

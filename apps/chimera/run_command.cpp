@@ -130,12 +130,15 @@ class Session {
 
   void print_events(bool& prompt_shown) {
     std::string events = control_.drain_events();
-    // The bridge's news among the subsystem's own: an import stale or back, a remote refused. It
-    // reads the subsystem's file when the table was made anew: under the gate, so that no
-    // command changes the file meanwhile.
-    if (remote_ != nullptr)
-      for (const auto& line : control_.exclusive([&](Control&, Subsystem&) { return remote_->poll(); }))
-        events += "dds: " + line + "\n";
+    // The bridge's news among the subsystem's own: an import stale or back, a remote refused.
+    // When the table was made anew it follows the subsystem's file as it is now, read under the
+    // gate, so that no command changes the file meanwhile.
+    if (remote_ != nullptr) {
+      if (remote_->table_made_anew())
+        for (const auto& line : control_.exclusive([&](Control&, Subsystem&) { return remote_->follow(); }))
+          events += "dds: " + line + "\n";
+      for (const auto& line : remote_->news()) events += "dds: " + line + "\n";
+    }
     if (events.empty()) return;
     // Keep the operator's prompt usable: events go on their own lines, then the prompt again.
     if (prompt_shown) out("\n");

@@ -44,8 +44,11 @@ ProcessExecutive::ProcessExecutive(ExecutiveSetup setup)
       events_(setup.events),
       realtime_(setup.realtime_priorities),
       block_(setup.processes.block),
-      launch_{setup.processes.worker_program, setup.processes.worker_args, setup.processes.block->fd(),
-              setup.processes.history_fd} {
+      launch_{setup.processes.worker_program,
+              setup.processes.worker_args,
+              setup.processes.block->fd(),
+              setup.processes.history_fd,
+              {}} {
   // One ModuleProcess per process name other than main, in order of first appearance.
   std::map<std::string, int> index;
   std::vector<bool> hosted(tasks_.size(), true);
