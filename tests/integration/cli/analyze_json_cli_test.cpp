@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "run_chimera.hpp"
+#include "support/json_text.hpp"
 
 namespace chimera::test {
 namespace {
@@ -33,7 +34,7 @@ class AnalyzeJsonTest : public ::testing::Test {
 
   // stdout parsed as exactly one document: json::parse fails on anything before or after it.
   static Json parse(const Outcome& o) {
-    Json doc = Json::parse(o.out, nullptr, /*allow_exceptions=*/false);
+    Json doc = test::parse_json(o.out, /*allow_exceptions=*/false);
     EXPECT_FALSE(doc.is_discarded()) << "stdout is not one JSON document:\n" << o.out;
     return doc;
   }

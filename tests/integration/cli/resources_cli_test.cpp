@@ -26,6 +26,7 @@
 
 #include "chimera/svt/detail/shm_layout.hpp"
 #include "run_chimera.hpp"
+#include "support/json_text.hpp"
 
 namespace chimera::test {
 namespace {
@@ -215,7 +216,7 @@ TEST_F(ResourcesCliTest, ALogWhoseDiskFillsDuringTheRunSaysSoCountsItsLostRowsAn
   const std::size_t count_at = last.find("kill failed: ") + std::string("kill failed: ").size();
   const std::uint64_t lost = std::stoull(last.substr(count_at));
   // Every row the task took is either in the file or counted lost (a cut last chunk counts lost).
-  const auto cycles = nlohmann::json::parse(read_text(json)).at("tasks").at("log").at("cycles").get<std::uint64_t>();
+  const auto cycles = test::parse_json(read_text(json)).at("tasks").at("log").at("cycles").get<std::uint64_t>();
   const std::uint64_t written = std::stoull(read_text(lines)) - 1;  // less the header
   EXPECT_GT(lost, 0U);
   EXPECT_LE(lost, cycles);

@@ -55,9 +55,9 @@ Outcome run_chimera(const TempDir& dir, const std::string& args, const std::stri
   return o;
 }
 
-std::string private_copy(const TempDir& dir, const std::string& name) {
+std::string private_copy_from(const std::string& data_dir, const TempDir& dir, const std::string& name) {
   static int copies = 0;
-  std::istringstream text(read_text(std::string(CLI_DATA_DIR) + "/" + name));
+  std::istringstream text(read_text(data_dir + "/" + name));
   std::string copy;
   for (std::string line; std::getline(text, line);) {
     if (line.rfind("subsystem:", 0) == 0)

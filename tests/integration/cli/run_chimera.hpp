@@ -33,9 +33,17 @@ void write_text(const std::string& path, const std::string& text);
 Outcome run_chimera(const TempDir& dir, const std::string& args, const std::string& input = {},
                     const std::string& prefix = {});
 
-/// A copy of data file `name` under `dir` with a subsystem name no other test process uses,
-/// since a running subsystem owns the shared memory of its name.
-std::string private_copy(const TempDir& dir, const std::string& name);
+/// A copy of `data_dir`'s file `name` under `dir` with a subsystem name no other test process
+/// uses, since a running subsystem owns the shared memory of its name.
+std::string private_copy_from(const std::string& data_dir, const TempDir& dir, const std::string& name);
+
+#ifdef CLI_DATA_DIR
+/// private_copy_from the test's data folder (chimera_cli_test's DATA_DIR): defined here, in the
+/// test's own file, since this helper is compiled once for every test program.
+inline std::string private_copy(const TempDir& dir, const std::string& name) {
+  return private_copy_from(CLI_DATA_DIR, dir, name);
+}
+#endif
 
 /// `'text'` for the shell.
 std::string quoted(const std::string& text);

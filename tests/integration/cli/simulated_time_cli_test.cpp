@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "run_chimera.hpp"
+#include "support/json_text.hpp"
 
 namespace chimera::test {
 namespace {
@@ -43,7 +44,7 @@ class SimulatedTimeTest : public ::testing::Test {
     const auto o =
         chimera("run " + data(file) + " --clock virtual --for " + for_spec + " --stats-json " + quoted(json));
     EXPECT_TRUE(o.exit_code == 0 || o.exit_code == 1) << o.err;
-    return Json::parse(read_text(json));
+    return test::parse_json(read_text(json));
   }
 
  private:
@@ -53,7 +54,7 @@ class SimulatedTimeTest : public ::testing::Test {
 TEST_F(SimulatedTimeTest, AnalyzeTakesTheSimulatedTimeAndTheRunAgrees) {
   const auto o = chimera("analyze " + data("analyze_muf_simulated.yaml") + " --json");
   EXPECT_EXIT_CODE(o, 0);
-  const Json doc = Json::parse(o.out);
+  const Json doc = test::parse_json(o.out);
   // The C the virtual clock charges, exactly: 2 ms from cpu_load, 3 ms from virtual_exec.
   EXPECT_EQ(task(doc, "a").at("wcet_ns"), 2 * kMs);
   EXPECT_EQ(task(doc, "a").at("wcet_source"), "simulated");
@@ -90,7 +91,7 @@ TEST_F(SimulatedTimeTest, AnalyzeTakesTheSimulatedTimeAndTheRunAgrees) {
 TEST_F(SimulatedTimeTest, AnOverloadInSimulatedTimeIsNotFeasible) {
   const auto o = chimera("analyze " + data("analyze_muf_simulated_overload.yaml") + " --json");
   EXPECT_EXIT_CODE(o, 1);
-  const Json doc = Json::parse(o.out);
+  const Json doc = test::parse_json(o.out);
   EXPECT_EQ(task(doc, "x").at("wcet_ns"), 3 * kMs);
   EXPECT_EQ(task(doc, "y").at("wcet_ns"), 3 * kMs);
   // Neither C is known before the run, so both are critical, and the set fails EDF's test.

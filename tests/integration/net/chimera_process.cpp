@@ -6,9 +6,10 @@
 #include <unistd.h>
 
 #include <chrono>
-#include <regex>
 #include <stdexcept>
 #include <thread>
+
+#include "support/text_search.hpp"
 
 namespace chimera::test {
 
@@ -73,11 +74,12 @@ bool ChimeraProcess::running() {
 }
 
 int ChimeraProcess::port() {
-  static const std::regex kLine(R"(control API on http://[^ ]*:([0-9]+)/api/)");
   for (int i = 0; i < 600; ++i) {
-    std::smatch m;
-    const std::string text = err();
-    if (std::regex_search(text, m, kLine)) return std::stoi(m[1].str());
+    // "control API on http://HOST:PORT/api/": the port is after the address's last colon.
+    const auto address = test::text_after(err(), "control API on http://", "/ \n");
+    const auto colon = address ? address->rfind(':') : std::string::npos;
+    if (colon != std::string::npos && test::only_of(address->substr(colon + 1), "0123456789"))
+      return std::stoi(address->substr(colon + 1));
     if (!running()) return 0;
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
   }

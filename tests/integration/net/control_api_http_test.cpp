@@ -9,7 +9,6 @@
 
 #include <atomic>
 #include <csignal>
-#include <regex>
 #include <string>
 #include <thread>
 #include <vector>
@@ -20,6 +19,8 @@
 #include "chimera_process.hpp"
 #include "http_client.hpp"
 #include "run_chimera.hpp"
+#include "support/json_text.hpp"
+#include "support/text_search.hpp"
 
 namespace chimera::test {
 namespace {
@@ -32,7 +33,7 @@ const std::string kViewer = "viewer-token-0123456789abcdef";
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
 json body_of(const HttpResponse& r) {
-  json doc = json::parse(r.body, nullptr, false);
+  json doc = test::parse_json(r.body, false);
   return doc.is_discarded() ? json{{"unparsed", r.body}} : doc;
 }
 
@@ -143,11 +144,11 @@ TEST_F(ControlApiHttpTest, EveryShellCommandOverHttp) {
   EXPECT_REPLY(run("off traj"), 200);
   r = run("set theta_d 0.5 -0.25 1e-3 0 0 2");
   EXPECT_REPLY(r, 200);
-  EXPECT_EQ(body_of(r)["values"], json::parse("[0.5, -0.25, 0.001, 0, 0, 2]"));
+  EXPECT_EQ(body_of(r)["values"], test::parse_json("[0.5, -0.25, 0.001, 0, 0, 2]"));
   HttpRequest variable{"GET", "/api/variables/theta_d", kViewer};
   r = http(port_, variable);
   EXPECT_REPLY(r, 200);
-  EXPECT_EQ(body_of(r)["values"], json::parse("[0.5, -0.25, 0.001, 0, 0, 2]"));
+  EXPECT_EQ(body_of(r)["values"], test::parse_json("[0.5, -0.25, 0.001, 0, 0, 2]"));
   variable.path = "/api/variables/nosuch";
   r = http(port_, variable);
   EXPECT_REPLY(r, 404);
@@ -428,28 +429,28 @@ TEST_F(ControlApiHttpTest, AGeneratedTokenIsPrintedOnceAndWrittenPrivately) {
   auto p = std::make_unique<ChimeraProcess>(dir_, args, std::vector<std::string>{"XDG_RUNTIME_DIR=" + dir_.path()});
   port_ = p->port();
   ASSERT_GT(port_, 0) << p->err();
-  std::smatch m;
   const std::string err = p->err();
-  ASSERT_TRUE(std::regex_search(err, m, std::regex("tokens in ([^ ;)]+); the operator's is in the page's link below")))
-      << err;
-  const std::string path = m[1];
-  ASSERT_TRUE(
-      std::regex_search(err, m, std::regex("Onika, the page, on http://127.0.0.1:[0-9]+/#token=([0-9a-f]{64})\n")))
-      << err;
-  const std::string token = m[1];
-  EXPECT_EQ(path,
-            dir_.path() + "/chimera/" +
-                json::parse(body_of(command(port_, token, "status"))["status"]["subsystem"].dump()).get<std::string>() +
-                "-" + std::to_string(port_) + ".token");
+  const std::string path = test::text_after(err, "tokens in ", " ;)\n").value_or("");
+  ASSERT_TRUE(contains(err, "tokens in " + path + "; the operator's is in the page's link below")) << err;
+  const std::string page = "Onika, the page, on http://127.0.0.1:" + std::to_string(port_) + "/#token=";
+  const std::string token = test::text_after(err, page, "\n").value_or("");
+  ASSERT_EQ(token.size(), 64U) << err;
+  ASSERT_TRUE(test::only_of(token, "0123456789abcdef")) << token;
+  EXPECT_EQ(
+      path,
+      dir_.path() + "/chimera/" +
+          test::parse_json(body_of(command(port_, token, "status"))["status"]["subsystem"].dump()).get<std::string>() +
+          "-" + std::to_string(port_) + ".token");
   struct stat st {};
   ASSERT_EQ(::stat(path.c_str(), &st), 0);
   EXPECT_EQ(st.st_mode & 0777, 0600U);
   const std::string file = read_text(path);
   EXPECT_TRUE(contains(file, "operator " + token + "\n")) << file;
-  std::smatch viewer;
-  ASSERT_TRUE(std::regex_search(file, viewer, std::regex("viewer ([0-9a-f]{64})"))) << file;
-  EXPECT_EQ(body_of(http(port_, HttpRequest{"GET", "/api/whoami", viewer[1]}))["role"], "viewer");
-  EXPECT_EQ(err.find(viewer[1]), std::string::npos) << "the viewer token is only in the file";
+  const std::string viewer_token = test::text_after(file, "viewer ", "\n").value_or("");
+  ASSERT_EQ(viewer_token.size(), 64U) << file;
+  ASSERT_TRUE(test::only_of(viewer_token, "0123456789abcdef")) << file;
+  EXPECT_EQ(body_of(http(port_, HttpRequest{"GET", "/api/whoami", viewer_token}))["role"], "viewer");
+  EXPECT_EQ(err.find(viewer_token), std::string::npos) << "the viewer token is only in the file";
   EXPECT_EQ(command(port_, token, "status").status, 200);
   // Printed once: the token appears on stderr one time, and never on stdout.
   EXPECT_EQ(err.find(token), err.rfind(token));

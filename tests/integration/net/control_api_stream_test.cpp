@@ -23,6 +23,7 @@
 #include "chimera_process.hpp"
 #include "http_client.hpp"
 #include "run_chimera.hpp"
+#include "support/json_text.hpp"
 
 namespace chimera::test {
 namespace {
@@ -65,7 +66,7 @@ int on_frame(mg_connection* /*conn*/, int bits, char* data, std::size_t size, vo
   auto& r = *static_cast<Received*>(user);
   if ((bits & 0x0f) != MG_WEBSOCKET_OPCODE_TEXT) return 1;
   std::lock_guard<std::mutex> lock(r.mutex);
-  r.frames.push_back(json::parse(std::string(data, size), nullptr, false));
+  r.frames.push_back(test::parse_json(std::string(data, size), false));
   r.arrived.notify_all();
   return 1;
 }
@@ -334,7 +335,7 @@ TEST_F(ControlApiStreamTest, AStalledStreamSlowsNeitherOtherStreamsNorTasks) {
   std::this_thread::sleep_for(std::chrono::seconds(1));
 
   auto cycles = [&] {
-    const json doc = json::parse(http(port_, HttpRequest{"GET", "/api/status", kViewer}).body, nullptr, false);
+    const json doc = test::parse_json(http(port_, HttpRequest{"GET", "/api/status", kViewer}).body, false);
     std::uint64_t total = 0;
     for (const auto& t : doc["status"]["tasks"]) total += t["cycles"].get<std::uint64_t>();
     return total;

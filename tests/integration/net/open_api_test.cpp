@@ -20,6 +20,7 @@
 #include "chimera_process.hpp"
 #include "http_client.hpp"
 #include "run_chimera.hpp"
+#include "support/json_text.hpp"
 
 namespace chimera::test {
 namespace {
@@ -30,7 +31,7 @@ const std::string kOperator = "operator-token-open-0123456789";
 const std::string kViewer = "viewer-token-open-0123456789";
 
 json body_of(const HttpResponse& r) {
-  json doc = json::parse(r.body, nullptr, false);
+  json doc = test::parse_json(r.body, false);
   return doc.is_discarded() ? json{{"unparsed", r.body}} : doc;
 }
 

@@ -18,6 +18,7 @@
 #include "chimera_process.hpp"
 #include "exec/task_shared.hpp"
 #include "run_chimera.hpp"
+#include "support/json_text.hpp"
 
 namespace chimera {
 namespace {
@@ -116,7 +117,7 @@ TEST(StuckTask, AStuckCycleIsGivenUpAndItsThreadMateRunsOn) {
   EXPECT_NE(err.find("ERROR: stuck in cycle() for"), std::string::npos) << err;
   EXPECT_NE(err.find("given up: its thread drops to SCHED_IDLE, and load moved to a new thread"), std::string::npos)
       << err;
-  const auto doc = nlohmann::json::parse(test::read_text(stats));
+  const auto doc = test::parse_json(test::read_text(stats));
   EXPECT_EQ(doc.at("tasks").at("spin").at("state"), "ERROR");
   EXPECT_EQ(doc.at("tasks").at("load").at("state"), "ON");  // the statistics are of the run, before the stop
   // 750 cycles in the last 1.5 s alone; a loaded machine may run fewer, never only the first 25.
@@ -164,7 +165,7 @@ TEST(StuckTask, AStuckOnIsGivenUpAndItsThreadMateRunsOn) {
   EXPECT_NE(err.find("ERROR: stuck in on() for"), std::string::npos) << err;
   EXPECT_NE(err.find("given up: its thread drops to SCHED_IDLE, and load moved to a new thread"), std::string::npos)
       << err;
-  const auto doc = nlohmann::json::parse(test::read_text(stats));
+  const auto doc = test::parse_json(test::read_text(stats));
   EXPECT_EQ(doc.at("tasks").at("stuck").at("state"), "ERROR");
   EXPECT_EQ(doc.at("tasks").at("load").at("state"), "ON");
   // 150 cycles before the signal, none for the 10 s it held the thread, then 1,250 in the last

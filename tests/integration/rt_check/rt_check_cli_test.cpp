@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "run_chimera.hpp"
+#include "support/json_text.hpp"
 
 namespace chimera::test {
 namespace {
@@ -54,7 +55,7 @@ class RtCheckCliTest : public ::testing::Test {
     return path;
   }
 
-  nlohmann::json stats() { return nlohmann::json::parse(read_text(dir_.file("stats.json"))); }
+  nlohmann::json stats() { return test::parse_json(read_text(dir_.file("stats.json"))); }
   std::string stats_arg() { return " --stats-json " + quoted(dir_.file("stats.json")); }
 
   TempDir dir_;

@@ -9,6 +9,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "support/json_text.hpp"
+
 namespace chimera::analysis {
 namespace {
 
@@ -89,7 +91,7 @@ TEST(ReportJson, FieldsComeFromTheResults) {
   const std::string text = analysis_json("f.yaml", configurations);
   ASSERT_FALSE(text.empty());
   EXPECT_EQ(text.back(), '\n');
-  const Json doc = Json::parse(text);
+  const Json doc = test::parse_json(text);
   EXPECT_EQ(doc.at("format"), "chimera-analyze");
   EXPECT_EQ(doc.at("format_version"), kAnalysisJsonFormatVersion);
   EXPECT_EQ(doc.at("file"), "f.yaml");
@@ -109,7 +111,7 @@ TEST(ReportJson, FieldsComeFromTheResults) {
   EXPECT_EQ(cpu0.at("outcome"), "response_time_exceeds_deadline");
   EXPECT_FALSE(cpu0.contains("edf"));
   const Json& fast = cpu0.at("tasks").at(0);  // the results' order, not the file's
-  EXPECT_EQ(fast, Json::parse(R"({"name": "fast", "cpu": 0, "placed": "pinned", "criticality": "hard",
+  EXPECT_EQ(fast, test::parse_json(R"({"name": "fast", "cpu": 0, "placed": "pinned", "criticality": "hard",
       "period_ns": 5000000, "deadline_ns": 5000000, "wcet_ns": 2000000, "wcet_source": "file",
       "analysed_c_ns": 2000000, "response_ns": 2000000, "response_kind": "exact", "release_jitter_ns": 0,
       "verdict": "meets", "reason": ""})"));
@@ -144,10 +146,10 @@ TEST(ReportJson, FieldsComeFromTheResults) {
 }
 
 TEST(ReportJson, AFeasibleFileAndNoConfigurations) {
-  EXPECT_EQ(Json::parse(analysis_json("f.yaml", {})).at("feasible"), true);
+  EXPECT_EQ(test::parse_json(analysis_json("f.yaml", {})).at("feasible"), true);
   AnalysedConfiguration c = muf_configuration();
   c.result.feasible = true;
-  EXPECT_EQ(Json::parse(analysis_json("f.yaml", std::vector{c})).at("feasible"), true);
+  EXPECT_EQ(test::parse_json(analysis_json("f.yaml", std::vector{c})).at("feasible"), true);
 }
 
 TEST(ReportJson, AnEdfDemandFailureCarriesItsInterval) {
@@ -169,9 +171,10 @@ TEST(ReportJson, AnEdfDemandFailureCarriesItsInterval) {
   c.result.cpu_of = {0};
   c.result.cpus = {cpu};
   c.result.feasible = false;
-  const Json edf = Json::parse(analysis_json("f.yaml", std::vector{c})).at("configurations").at(0).at("cpus").at(0);
+  const Json edf =
+      test::parse_json(analysis_json("f.yaml", std::vector{c})).at("configurations").at(0).at("cpus").at(0);
   EXPECT_EQ(edf.at("outcome"), "demand_exceeded");
-  EXPECT_EQ(edf.at("edf"), Json::parse(R"({"outcome": "demand_exceeded", "utilisation": 0.9,
+  EXPECT_EQ(edf.at("edf"), test::parse_json(R"({"outcome": "demand_exceeded", "utilisation": 0.9,
       "utilisation_decides": false, "demand_bound_ns": 16000000, "points": 5, "interval_ns": 6000000,
       "demand_ns": 7000000})"));
 }

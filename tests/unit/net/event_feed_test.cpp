@@ -18,6 +18,7 @@
 #include "chimera/config/loader.hpp"
 #include "chimera/control/subsystem.hpp"
 #include "chimera/net/control_gate.hpp"
+#include "support/json_text.hpp"
 #include "unit/control/test_modules.hpp"
 
 namespace chimera::net {
@@ -75,7 +76,7 @@ class EventFeedTest : public ::testing::Test {
     std::vector<json> out;
     for (std::size_t i = 0; i < got.size(); ++i) {
       EXPECT_EQ(got[i].seq, first_ + i);
-      out.push_back(json::parse(got[i].json));
+      out.push_back(test::parse_json(got[i].json));
     }
     return out;
   }
