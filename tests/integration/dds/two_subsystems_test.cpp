@@ -119,7 +119,9 @@ struct Side {
     eventually([&] {
       const std::string out = process->out();
       reply = out.size() > before ? out.substr(before) : std::string();
-      return reply.find(variable + " = [") != std::string::npos && reply.ends_with("]\n");
+      // A variable no task has written yet has a reply of its own, which ends the wait as well.
+      return (reply.find(variable + " = [") != std::string::npos && reply.ends_with("]\n")) ||
+             reply.ends_with(variable + " has not been written yet\n");
     });
     return reply;
   }
@@ -143,6 +145,12 @@ struct Side {
   }
 
   // The numbers of a `get` reply, "NAME = [a, b, ...]".
+  // True when `reply` holds six values, not all zero: an unwritten variable's reply holds none.
+  static bool written_nonzero(const std::string& reply) {
+    const std::vector<double> v = values(reply);
+    return v.size() == 6 && v != std::vector<double>(6, 0.0);
+  }
+
   static std::vector<double> values(const std::string& reply) {
     std::vector<double> out;
     const auto open = reply.find('[');
@@ -283,8 +291,9 @@ TEST(TwoSubsystems, TheBridgeFollowsTheTableThatAnAddMadeAnew) {
     return robot.err().find("dds: import x_d: first sample, from subsystem " + names.vision + "\n") !=
            std::string::npos;
   })) << robot.err();
-  const std::string x_m_before = vision.get("x_m");
-  ASSERT_NE(Side::values(x_m_before), std::vector<double>(6, 0.0)) << "x_m came before the add";
+  std::string x_m_before;
+  ASSERT_TRUE(eventually([&] { return Side::written_nonzero(x_m_before = vision.get("x_m")); }))
+      << "x_m came before the add: " << x_m_before;
 
   // The vision task gone: the robot side's import goes stale; back after the add, fresh again.
   const std::size_t fresh_before = count(robot.err(), fresh);
@@ -295,8 +304,7 @@ TEST(TwoSubsystems, TheBridgeFollowsTheTableThatAnAddMadeAnew) {
   EXPECT_TRUE(eventually([&] { return vision.err().find("the bridge follows it") != std::string::npos; }, 10))
       << vision.err() << vision.process->out();
   // The new table's x_m is unwritten until the bridge writes it there: it does, from the robot.
-  EXPECT_TRUE(eventually([&] { return Side::values(vision.get("x_m")) != std::vector<double>(6, 0.0); }))
-      << vision.get("x_m");
+  EXPECT_TRUE(eventually([&] { return Side::written_nonzero(vision.get("x_m")); })) << vision.get("x_m");
   vision.process->send("spawn vision\non vision\n");
   ASSERT_TRUE(eventually([&] { return count(robot.err(), fresh) > fresh_before; })) << robot.err() << vision.err();
   const std::string x_d = robot.get("x_d");
@@ -329,7 +337,7 @@ TEST(TwoSubsystems, AFileOpenedWithImportsIsBridged) {
             std::string::npos)
       << robot.err();
   // The other way: x_m from the opened file's forward kinematics reaches the vision side.
-  EXPECT_TRUE(eventually([&] { return Side::values(vision.get("x_m")) != std::vector<double>(6, 0.0); }))
+  EXPECT_TRUE(eventually([&] { return Side::written_nonzero(vision.get("x_m")); }))
       << vision.get("x_m") << vision.err();
 
   const std::string plain_again = robot.dir.file("plain_again.yaml");
