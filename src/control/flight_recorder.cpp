@@ -145,7 +145,7 @@ Result<std::unique_ptr<FlightRecorder>> FlightRecorder::attach(const ResolvedSub
 }
 
 Result<void> FlightRecorder::write_variables(const std::string& path) const {
-  std::vector<std::vector<HistoryRings::Record>> held;
+  std::vector<HistoryRings::Records> held;
   std::vector<std::int64_t> instants;
   std::string header = "t";
   for (const RecordedVariable& rv : variables_) {

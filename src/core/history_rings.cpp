@@ -121,27 +121,25 @@ std::uint64_t HistoryRings::written(std::size_t r) const noexcept {
   return Word(block_[rings_[r].offset]).load(std::memory_order_acquire);
 }
 
-std::vector<HistoryRings::Record> HistoryRings::read(std::size_t r) const {
+HistoryRings::Records HistoryRings::read(std::size_t r) const {
   const Ring& ring = rings_[r];
   std::uint64_t* head = block_ + ring.offset;
   const std::uint64_t last = written(r);
   const std::uint64_t first = last > ring.capacity ? last - ring.capacity + 1 : 1;
-  std::vector<Record> out;
+  Records out(ring.payload_words);
   out.reserve(static_cast<std::size_t>(last - first + 1));
   for (std::uint64_t w = first; w <= last; ++w) {
     std::uint64_t* record = head + 1 + ((w - 1) % ring.capacity) * (kHeaderWords + ring.payload_words);
     // Acquire: pairs with the writer's release store of the even stamp: the words are its.
     const std::uint64_t s1 = Word(record[0]).load(std::memory_order_acquire);
     if (s1 != 2 * w) continue;  // already being overwritten by a later record
-    Record copy;
     // Acquire (each word): orders the loads before the re-check of the stamp below.
-    copy.time_ns = static_cast<std::int64_t>(Word(record[1]).load(std::memory_order_acquire));
-    copy.words.resize(ring.payload_words);
+    const std::span<std::uint64_t> words =
+        out.append(static_cast<std::int64_t>(Word(record[1]).load(std::memory_order_acquire)));
     for (std::uint32_t i = 0; i < ring.payload_words; ++i)
-      copy.words[i] = Word(record[kHeaderWords + i]).load(std::memory_order_acquire);
+      words[i] = Word(record[kHeaderWords + i]).load(std::memory_order_acquire);
     // Relaxed: the acquire loads above keep it after them.
-    if (Word(record[0]).load(std::memory_order_relaxed) != s1) continue;  // overwritten while copied
-    out.push_back(std::move(copy));
+    if (Word(record[0]).load(std::memory_order_relaxed) != s1) out.drop_last();  // overwritten while copied
   }
   return out;
 }

@@ -1,5 +1,6 @@
 #include "real_executive.hpp"
 
+#include <malloc.h>
 #include <pthread.h>
 #include <sched.h>
 #include <sys/eventfd.h>
@@ -107,6 +108,10 @@ void prepare_realtime_process(bool realtime) {
   if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0)
     warn_once(g_warned_mlock, fmt::format("mlockall refused ({}): memory of real-time tasks may be paged",
                                           std::generic_category().message(errno)));
+  // Locked, freed heap stays resident (only its top is ever given back). A large temporary (a
+  // flight-recorder dump's copy of a ring) gets a mapping of its own, given back when freed:
+  // glibc's default threshold rises past the first such block freed, and puts the next in the heap.
+  mallopt(M_MMAP_THRESHOLD, 128 * 1024);
 }
 
 RealExecutive::RealExecutive(ExecutiveSetup setup)

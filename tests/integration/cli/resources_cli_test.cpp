@@ -11,6 +11,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
@@ -224,6 +225,27 @@ TEST_F(ResourcesCliTest, ALogWhoseDiskFillsDuringTheRunSaysSoCountsItsLostRowsAn
   // The timing table still came out, and nothing was left in /dev/shm.
   EXPECT_TRUE(contains(o.out, "latency p99")) << o.out;
   EXPECT_FALSE(std::filesystem::exists(region_path(n)));
+}
+
+// On the real clock the tasks run on while the run ends. The figures of --stats-json are
+// those of the tasks stopped, so that every cycle the logger ran has its row, and the other way
+// round (the hour's soak found one row more than the cycles, when the figures were taken a moment
+// before the tasks stopped).
+TEST_F(ResourcesCliTest, ARealClockRunsFiguresCountEveryRowItsLoggerWrote) {
+  const std::string n = tracked(name("rows"));
+  const std::string json = dir_.file("stats.json");
+  const auto o = chimera("run " + quoted(file(n)) + " --clock real --for 1500ms --stats-json " + quoted(json));
+  EXPECT_EXIT_CODE(o, 0);
+  const auto log = test::parse_json(read_text(json)).at("tasks").at("log");
+  EXPECT_EQ(log.at("state"), "ON");  // the state while it ran, not NOT-CREATED
+  const auto cycles = log.at("cycles").get<std::uint64_t>();
+  EXPECT_GT(cycles, 500U);
+  // A ring that filled (the writer thread starved for a second) would say how many rows it
+  // dropped: then this comparison would not hold, and the message says why.
+  const std::string rows = read_text(dir_.file("log.csv"));
+  const auto lines = static_cast<std::uint64_t>(std::count(rows.begin(), rows.end(), '\n'));
+  ASSERT_GE(lines, 1U);
+  EXPECT_EQ(lines - 1, cycles) << o.err;  // less the header
 }
 
 TEST_F(ResourcesCliTest, TheRegionOfARunKilledWithSigkillIsReclaimedWhateverBecameOfItsPid) {
