@@ -102,6 +102,7 @@ Result<void> read_constants(const Source& source, const MapReader& top, Subsyste
   for (const auto& [value, name] : entries(*f)) {
     if (!is_identifier(name))
       return source.fail(value, "not a valid variable name (letters, digits and _, not starting with a digit)");
+    if (auto ok = config_detail::check_variable_name_length(source, value, name); !ok) return ok.error();
     auto numbers = config_detail::read_numbers(source, value);
     if (!numbers) return numbers.error();
     spec.constants.emplace_back(name, *std::move(numbers));

@@ -23,6 +23,7 @@
 
 #include <fmt/format.h>
 
+#include "chimera/core/identifier.hpp"
 #include "chimera/svt/detail/shm_layout.hpp"
 #include "region_ownership.hpp"
 
@@ -76,6 +77,9 @@ Result<void> check_subsystem_name(std::string_view name) {
   }
   return {};
 }
+
+// The loader checks names against kMaxVariableName: it must be what the region's field holds.
+static_assert(svt_detail::kNameCapacity == kMaxVariableName + 1);
 
 Result<void> check_vars(std::span<const VarSpec> vars) {
   if (vars.size() > std::numeric_limits<std::uint32_t>::max()) {

@@ -103,6 +103,7 @@ Result<void> read_imports(const Source& source, const std::optional<Field>& fiel
     const auto& name = entry.second;
     if (!is_identifier(name))
       return source.fail(value, "not a valid variable name (letters, digits and _, not starting with a digit)");
+    if (auto ok = check_variable_name_length(source, value, name); !ok) return ok.error();
     const bool exported = std::any_of(spec.exports.begin(), spec.exports.end(),
                                       [&](const ExportSpec& x) { return x.variable == name; });
     if (exported)

@@ -117,6 +117,10 @@ Result<void> read_server(const Source& source, const MapReader& map, TaskSpec& t
     auto ns = read_duration(source, *field);
     if (!ns) return ns.error();
     if (*ns <= 0) return source.fail(*field, "must be greater than zero");
+    // A server replenishes its budget every period, as a timer release: the same floor as a task's.
+    if (out == &spec.period_ns && *ns < kShortestPeriodNs)
+      return source.fail(*field, fmt::format("{} is shorter than {}, the shortest period a server can replenish at",
+                                             field->node.Scalar(), format_period(kShortestPeriodNs)));
     *out = *ns;
   }
   if (spec.budget_ns > spec.period_ns)
@@ -213,7 +217,7 @@ Result<void> read_rename(const Source& source, const Field& field, const ModuleI
       if (ports.empty()) return source.fail(value, fmt::format("{} has no ports to rename", info.name));
       return source.fail(value, fmt::format("{} has no port {} (ports: {})", info.name, port, fmt::join(ports, ", ")));
     }
-    auto variable = read_identifier(source, value, "variable name");
+    auto variable = read_variable_name(source, value);
     if (!variable) return variable.error();
     task.rename[port] = *std::move(variable);
   }
@@ -224,6 +228,21 @@ Result<void> read_rename(const Source& source, const Field& field, const ModuleI
       if (other != port && task.variable_of(other) == variable)
         return source.fail(value, fmt::format("ports {} and {} of {} would both be bound to variable {}", port, other,
                                               task.name, variable));
+  }
+  return {};
+}
+
+// A port not renamed names its variable itself: a module may declare a port name longer than the
+// table holds, and the file can still run it by renaming that port.
+Result<void> check_port_variable_names(const Source& source, const Field& module_field, const ModuleInfo& info,
+                                       const TaskSpec& task) {
+  const Declarations decls = info.declarations(task.params);
+  for (const auto& p : decls.ports()) {
+    const std::string variable = task.variable_of(p.name);
+    if (variable.size() > kMaxVariableName)
+      return source.fail(module_field, fmt::format("port {} of {} names variable {}, longer than {} characters (the "
+                                                   "state variable table's limit): rename it",
+                                                   p.name, info.name, variable, kMaxVariableName));
   }
   return {};
 }
@@ -269,6 +288,7 @@ Result<TaskSpec> load_task(const Source& source, const Field& task_field, const 
   if (const auto rename = map->get("rename")) {
     if (auto ok = read_rename(source, *rename, **info, task); !ok) return ok.error();
   }
+  if (auto ok = check_port_variable_names(source, *module_field, **info, task); !ok) return ok.error();
   return task;
 }
 

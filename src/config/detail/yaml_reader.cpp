@@ -140,6 +140,21 @@ Result<std::string> read_identifier(const Source& source, const Field& field, st
   return text;
 }
 
+Result<std::string> read_variable_name(const Source& source, const Field& field) {
+  auto name = read_identifier(source, field, "variable name");
+  if (!name) return name.error();
+  if (auto ok = check_variable_name_length(source, field, *name); !ok) return ok.error();
+  return name;
+}
+
+Result<void> check_variable_name_length(const Source& source, const Field& field, std::string_view name) {
+  if (name.size() > kMaxVariableName)
+    return source.fail(field, fmt::format("variable name \"{}\" is longer than {} characters (the state variable "
+                                          "table's limit)",
+                                          name, kMaxVariableName));
+  return {};
+}
+
 Result<std::string> read_process_name(const Source& source, const Field& field) {
   auto name = read_identifier(source, field, "process name");
   if (!name) return name.error();

@@ -77,6 +77,10 @@ std::optional<bool> as_bool(const YAML::Node& node);
 
 Result<std::string> read_text(const Source& source, const Field& field);
 Result<std::string> read_identifier(const Source& source, const Field& field, std::string_view what);
+/// A state variable's name: an identifier of at most kMaxVariableName characters.
+Result<std::string> read_variable_name(const Source& source, const Field& field);
+/// Fails, at `field`, on a variable name longer than kMaxVariableName (for names read as keys).
+Result<void> check_variable_name_length(const Source& source, const Field& field, std::string_view name);
 /// A `process:` name (docs/processes.md): an identifier of at most kMaxProcessName characters.
 Result<std::string> read_process_name(const Source& source, const Field& field);
 inline constexpr std::size_t kMaxProcessName = 40;

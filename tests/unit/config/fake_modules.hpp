@@ -8,6 +8,7 @@
 #include <string>
 #include <utility>
 
+#include "chimera/core/identifier.hpp"
 #include "chimera/module/module.hpp"
 #include "chimera/module/registry.hpp"
 
@@ -109,6 +110,10 @@ inline Registry make_test_registry() {
   });
   add_fake(r, "bad_sized", [](Declarations& d, const Params&) {
     d.out_var("y", Dim::of("missing_symbol"), "sized by a port that does not exist");
+  });
+  // A port name one character past what the state variable table holds: runnable only renamed.
+  add_fake(r, "long_port", [](Declarations& d, const Params&) {
+    d.out_var(std::string(kMaxVariableName + 1, 'p'), Dim::fixed(1), "a port named at length");
   });
   return r;
 }

@@ -117,6 +117,31 @@ TEST(LoaderErrors, BadConstants) {
             "pid.yaml:4: constants.a: written twice (first at line 3)");
 }
 
+// A variable's name lives in a 64-byte field of the table's shared memory: the loader refuses a
+// longer one at its line, where `run` once refused it with no line at all.
+TEST(LoaderErrors, VariableNamesLongerThanTheTableHoldsAreRefusedAtTheirLine) {
+  const std::string at_limit(kMaxVariableName, 'v');
+  const std::string over(kMaxVariableName + 1, 'v');
+  const std::string limit_note = " is longer than 63 characters (the state variable table's limit)";
+  EXPECT_TRUE(load_subsystem_text("subsystem: s\nconstants:\n  " + at_limit + ": 1\n" + kOneTask, "pid.yaml",
+                                  test::config_test_registry())
+                  .ok());
+  EXPECT_EQ(error_of("subsystem: s\nconstants:\n  " + over + ": 1\n" + kOneTask),
+            "pid.yaml:3: constants." + over + ": variable name \"" + over + "\"" + limit_note);
+  EXPECT_EQ(error_of("subsystem: s\ntasks:\n  - name: v\n    module: visual_servo\n    rename: { x_d: " + over + " }\n"),
+            "pid.yaml:5: tasks[0].rename.x_d: variable name \"" + over + "\"" + limit_note);
+  EXPECT_EQ(error_of("subsystem: s\nimports:\n  " + over + ": { type: f64, count: 1, max_age: 5ms }\n" + kOneTask),
+            "pid.yaml:3: imports." + over + ": variable name \"" + over + "\"" + limit_note);
+  const std::string port(kMaxVariableName + 1, 'p');
+  EXPECT_EQ(error_of("subsystem: s\ntasks:\n  - name: l\n    module: long_port\n"),
+            "pid.yaml:4: tasks[0].module: port " + port + " of long_port names variable " + port +
+                ", longer than 63 characters (the state variable table's limit): rename it");
+  EXPECT_TRUE(load_subsystem_text("subsystem: s\ntasks:\n  - name: l\n    module: long_port\n    rename: { " + port +
+                                      ": y }\n",
+                                  "pid.yaml", test::config_test_registry())
+                  .ok());
+}
+
 // ---- tasks ---------------------------------------------------------------------------------
 
 TEST(LoaderErrors, MissingOrEmptyTasks) {
@@ -183,7 +208,7 @@ TEST(LoaderErrors, UnknownModule) {
   EXPECT_EQ(error_of("subsystem: s\ntasks:\n  - name: a\n    module: pidd\n"),
             "pid.yaml:4: tasks[0].module: no module named pidd (known: any_logger, bad_sized, damped_least_squares, "
             "f32_logger, "
-            "fwd_kin_jacobian, inv_kin, join_weighted_average, joint_traj_gen, pid_joint, robot_position, "
+            "fwd_kin_jacobian, inv_kin, join_weighted_average, joint_traj_gen, long_port, pid_joint, robot_position, "
             "robot_torque, time_integrator, visual_servo)");
   const Registry empty;
   auto r = load_subsystem_text("subsystem: s\ntasks:\n  - name: a\n    module: pid\n", "e.yaml", empty);
@@ -296,6 +321,10 @@ TEST(LoaderErrors, BadSchedulingKeys) {
             "pid.yaml:5: tasks[0].server.budget: must be greater than zero");
   EXPECT_EQ(error_of(aperiodic + "    server: {budget: 11ms, period: 10ms}\n"),
             "pid.yaml:5: tasks[0].server.budget: the budget cannot be longer than the server's period");
+  // A server replenishes on a timer: a task's period floor holds for it too.
+  EXPECT_EQ(error_of(aperiodic + "    server: {budget: 1ns, period: 2ns}\n"),
+            "pid.yaml:5: tasks[0].server.period: 2ns is shorter than 10 µs, the shortest period a server can "
+            "replenish at");
   EXPECT_EQ(error_of(aperiodic + "    server: 10ms\n"),
             "pid.yaml:5: tasks[0].server: a server must be a mapping of keys, not \"10ms\"");
 }
