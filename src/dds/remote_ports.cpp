@@ -10,6 +10,7 @@
 #include <chrono>
 #include <array>
 #include <deque>
+#include <limits>
 #include <mutex>
 #include <optional>
 #include <set>
@@ -28,6 +29,9 @@
 
 namespace chimera {
 namespace {
+
+// An import's last_update_ns before its first sample: never received is stale, not fresh.
+constexpr std::int64_t kNeverUpdated = std::numeric_limits<std::int64_t>::min();
 
 using dds_detail::SampleStamp;
 using dds_detail::WriterShape;
@@ -84,9 +88,9 @@ struct ImportPort {
   ImportSpec spec;
   VarIndex index = 0;
   dds_entity_t reader = 0;
-  // Monotonic, ours; the bridge's start before the first sample. Relaxed everywhere: a time on its
+  // Monotonic, ours; kNeverUpdated before the first sample. Relaxed everywhere: a time on its
   // own, written by DDS's listener thread and judged by the taker's.
-  std::atomic<std::int64_t> last_update_ns{0};
+  std::atomic<std::int64_t> last_update_ns{kNeverUpdated};
   std::set<dds_instance_handle_t> discovered;  // remote writers whose shape was checked (the taker's)
   bool said_stale = false;                     // the taker's: the last change reported was "stale"
   ImportStatus status;                         // guarded by Impl::status_mutex
@@ -139,7 +143,7 @@ struct RemotePorts::Impl {
   /// one thread hop fewer than a waitset's. Cyclone DDS calls one reader's listener at a time.
   Result<void> listen_to_imports();
   void take_sample(ImportPort& port, const Msg& msg, const dds_sample_info_t& info);
-  Result<void> add_import(const ImportSpec& import, dds_entity_t subscriber, dds_entity_t topic, std::int64_t start);
+  Result<void> add_import(const ImportSpec& import, dds_entity_t subscriber, dds_entity_t topic);
   void check_echo(ExportPort& port);
   void check_discovered(ImportPort& port);
   void refuse_shape(const ImportPort& port, const std::string& who, std::uint32_t length);
@@ -294,13 +298,15 @@ void RemotePorts::Impl::judge_staleness() {
     std::lock_guard guard(status_mutex);
     for (auto& port : imports) {
       const std::int64_t last = port.last_update_ns.load(std::memory_order_relaxed);  // relaxed: as declared
-      port.status.stale = now - last > port.spec.max_age_ns;
+      const bool never = last == kNeverUpdated;
+      port.status.stale = never || now - last > port.spec.max_age_ns;
       any_stale = any_stale || port.status.stale;
       if (port.status.stale == port.said_stale) continue;
       port.said_stale = port.status.stale;
       changes.push_back(port.status.stale
-                            ? fmt::format("import {}: stale, no sample for {} (max_age){}", port.spec.variable,
-                                          format_duration(now - last),
+                            ? fmt::format("import {}: stale, {}{}", port.spec.variable,
+                                          never ? std::string("no sample yet")
+                                                : fmt::format("no sample for {} (max_age)", format_duration(now - last)),
                                           options.hold_when_stale ? ": the illegal-configuration flag is raised" : "")
                             : fmt::format("import {}: fresh again, from {}", port.spec.variable,
                                           port.status.writer.empty() ? std::string("a writer without a Chimera stamp")
@@ -372,12 +378,10 @@ Result<void> check_shape(const GlobalTable& table, const std::string& variable, 
 
 // One import's reader on `topic`, attached to the taker's waitset for its data and its discovered
 // writers.
-Result<void> RemotePorts::Impl::add_import(const ImportSpec& import, dds_entity_t subscriber, dds_entity_t topic,
-                                           std::int64_t start) {
+Result<void> RemotePorts::Impl::add_import(const ImportSpec& import, dds_entity_t subscriber, dds_entity_t topic) {
   ImportPort& port = imports.emplace_back();  // in place: a deque never moves it, and a listener holds it
   port.spec = import;
   port.status.variable = import.variable;
-  port.last_update_ns.store(start, std::memory_order_relaxed);  // before any thread
   if (auto ok = check_shape(table, import.variable, import.count, "import", port.index); !ok) return ok;
   Qos qos;
   dds_qset_history(qos.q, DDS_HISTORY_KEEP_LAST, 1);
@@ -458,9 +462,11 @@ Result<std::unique_ptr<RemotePorts>> RemotePorts::create(const SubsystemSpec& sp
       return make_error(Errc::kInvalidInput, dds_error(fmt::format("export {}", x.variable), heard));
     m.exports.push_back(std::move(port));
   }
-  const std::int64_t start = monotonic_ns();
   for (const auto& i : spec.imports)
-    if (auto added = m.add_import(i, subscriber, topic(i.variable), start); !added) return added.error();
+    if (auto added = m.add_import(i, subscriber, topic(i.variable)); !added) return added.error();
+  // Never received is stale: judged now, before any thread, so the flag is up (with
+  // hold_when_stale) before the caller lets a task read an import that has no value yet.
+  m.judge_staleness();
 
   m.stop_fd = ::eventfd(0, EFD_CLOEXEC);
   if (m.stop_fd < 0) return make_error(Errc::kSystem, "the bridge's publisher: no eventfd");
