@@ -11,8 +11,4 @@ bool is_identifier(std::string_view text) noexcept {
   });
 }
 
-bool is_variable_name(std::string_view text) noexcept {
-  return text.size() <= kMaxVariableName && is_identifier(text);
-}
-
 }  // namespace chimera

@@ -15,7 +15,4 @@ namespace chimera {
 /// than `run` refusing it later without one.
 inline constexpr std::size_t kMaxVariableName = 63;
 
-/// Whether `text` can name a state variable: an identifier of at most kMaxVariableName characters.
-[[nodiscard]] bool is_variable_name(std::string_view text) noexcept;
-
 }  // namespace chimera
