@@ -91,8 +91,13 @@ std::optional<analysis::AnalysedConfiguration> analyse_one(const SubsystemSpec& 
     auto run =
         measure_profile(spec, config.name, ClockKind::kVirtual, length, kMeasureRuns, analysis::kMeasuredMargin, 1.0);
     if (!run) {
-      fmt::print(stderr, "{}: configuration '{}': cannot run it to measure execution times: {}\n", spec.file,
-                 config.name, run.error().message);
+      // A refusal that points into the file (a module's init) leads with its file:line, as run's does.
+      const std::string& why = run.error().message;
+      if (why.starts_with(spec.file + ":"))
+        fmt::print(stderr, "{} (configuration '{}', run to measure its execution times)\n", why, config.name);
+      else
+        fmt::print(stderr, "{}: configuration '{}': cannot run it to measure execution times: {}\n", spec.file,
+                   config.name, why);
       return std::nullopt;
     }
     measured = *std::move(run);

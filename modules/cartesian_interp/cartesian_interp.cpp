@@ -5,6 +5,9 @@
 
 #include "module_docs/cartesian_interp.hpp"
 
+#include <array>
+#include <utility>
+
 #include "cartesian_interp/cartesian_motion.hpp"
 #include "chimera/module/registry.hpp"
 
@@ -48,9 +51,13 @@ class CartesianInterp final : public Module {
     limits_.acceleration = p.number("acceleration", limits_.acceleration);
     limits_.angular_speed = p.number("angular_speed", limits_.angular_speed);
     limits_.angular_acceleration = p.number("angular_acceleration", limits_.angular_acceleration);
-    for (const double limit :
-         {limits_.speed, limits_.acceleration, limits_.angular_speed, limits_.angular_acceleration})
-      if (!(limit > 0.0 && limit < 1e6)) return Status::fail("cartesian_interp: every limit must be > 0");
+    const std::array<std::pair<const char*, double>, 4> limits = {
+        {{"speed", limits_.speed},
+         {"acceleration", limits_.acceleration},
+         {"angular_speed", limits_.angular_speed},
+         {"angular_acceleration", limits_.angular_acceleration}}};
+    for (const auto& [name, limit] : limits)
+      if (!(limit > 0.0 && limit < 1e6)) return ctx.refuse(name, "cartesian_interp: every limit must be > 0");
     dt_ = ctx.period_s();
     if (dt_ <= 0.0) return Status::fail("cartesian_interp: the task must be periodic (give it a period)");
     x_goal_ = ctx.in<double>("x_goal");

@@ -42,6 +42,9 @@ constexpr std::size_t kMinRows = 1024;
 constexpr auto kDrainPeriod = std::chrono::milliseconds(20);
 constexpr auto kWaitForRoom = std::chrono::microseconds(20);
 constexpr std::size_t kWriteChunk = std::size_t{64} * 1024;  // bytes formatted before one fwrite
+// The ring's bound in bytes: `capacity` counts rows, whose width the variables set, so the rows
+// alone do not bound the memory (1e8 rows of 19 doubles would be 15 GB).
+constexpr std::size_t kMaxRingBytes = std::size_t{1} << 30;
 
 // The variables to record, each once, in the order given.
 StringList variables_of(const Params& p) {
@@ -97,7 +100,7 @@ class DataLogger final : public Module {
   Status init(InitContext& ctx) override {
     const Params& p = ctx.params();
     names_ = variables_of(p);
-    if (names_.empty()) return Status::fail("give variables: [names] to record");
+    if (names_.empty()) return ctx.refuse("variables", "give variables: [names] to record");
     std::size_t width = 1;  // t
     for (const auto& name : names_) {
       inputs_.push_back(ctx.in<double>(name));
@@ -107,11 +110,19 @@ class DataLogger final : public Module {
 
     const double capacity = p.number("capacity", 0.0);
     if (!(capacity >= 0.0) || capacity > 1e8 || capacity != std::floor(capacity))
-      return Status::fail("capacity must be a whole number of rows from 0 to 1e8");
+      return ctx.refuse("capacity", "capacity must be a whole number of rows from 0 to 1e8");
+    const std::size_t most_rows = kMaxRingBytes / (width * sizeof(double));
     std::size_t rows = static_cast<std::size_t>(capacity);
+    if (rows > most_rows)
+      return ctx.refuse("capacity", intern(fmt::format("{} rows of {} values take {} MiB, past the ring's {} MiB: "
+                                                       "at most {} rows",
+                                                       rows, width, rows * width * sizeof(double) >> 20,
+                                                       kMaxRingBytes >> 20, most_rows)));
     if (rows == 0) {
+      // One second of rows, within the bound: a tiny period must not size a billion rows.
       const double period = ctx.period_s();
-      rows = period > 0.0 ? std::max(kMinRows, static_cast<std::size_t>(std::ceil(1.0 / period))) : kMinRows;
+      const double per_second = period > 0.0 ? std::ceil(1.0 / period) : 0.0;
+      rows = std::min(most_rows, std::max(kMinRows, static_cast<std::size_t>(per_second)));
     }
     ring_ = std::make_unique<RowRing>(rows, width);
 
@@ -119,14 +130,15 @@ class DataLogger final : public Module {
     task_ = std::string(ctx.task_name());
     file_ = std::fopen(path_.c_str(), "w");
     if (file_ == nullptr)
-      return Status::fail(
-          intern(fmt::format("cannot write the log {}: {}", path_, std::generic_category().message(errno))));
+      return ctx.refuse(
+          "file", intern(fmt::format("cannot write the log {}: {}", path_, std::generic_category().message(errno))));
     // Unbuffered: out_ is the buffer, so each write's outcome is known at once, with its rows.
     (void)std::setvbuf(file_, nullptr, _IONBF, 0);
     out_.reserve(kWriteChunk + 4096);
     write_header();
     // A file that takes nothing (a full disk, /dev/full) is refused before the run starts.
-    if (write_failed_) return Status::fail(intern(fmt::format("cannot write the log {}: {}", path_, write_error_)));
+    if (write_failed_)
+      return ctx.refuse("file", intern(fmt::format("cannot write the log {}: {}", path_, write_error_)));
     timing_ = &ctx.timing();
     writing_ = true;  // before the thread: its start makes it visible there
     writer_ = std::thread([this] { write_loop(); });
@@ -159,16 +171,17 @@ class DataLogger final : public Module {
 
   Status kill() override {
     stop_writer();
-    const auto dropped = dropped_.load(std::memory_order_relaxed);
-    if (dropped > 0)
-      spdlog::warn("{}: {} rows not logged to {}: the ring of {} rows was full (raise capacity)", task_, dropped, path_,
-                   ring_->rows());
     // The log is not whole: the run must not end as if it were (chimera run exits 1 on this).
     // (A header that could not be written failed init, which said so.)
     if (write_failed_ && writing_)
       return Status::fail(intern(fmt::format("{} rows lost: the log {} could not be written from t = {} s on: {}",
-                                             lost_rows_, path_, first_lost_t_, write_error_)));
+                                             lost_rows_ + dropped(), path_, first_lost_t_, write_error_)));
     if (!failure_.empty()) return Status::fail(intern(fmt::format("the log {} is incomplete: {}", path_, failure_)));
+    if (dropped() > 0)
+      return Status::fail(
+          intern(fmt::format("{} rows lost: not logged to {}, the ring of {} rows was full (the "
+                             "writer fell behind: raise capacity)",
+                             dropped(), path_, ring_->rows())));
     return Status::ok();
   }
 
@@ -184,6 +197,9 @@ class DataLogger final : public Module {
       if (writer_gone_.load(std::memory_order_acquire)) return nullptr;
     }
   }
+
+  // Rows the cycle dropped because the ring was full; read once the writer has stopped.
+  [[nodiscard]] std::uint64_t dropped() const noexcept { return dropped_.load(std::memory_order_relaxed); }
 
   void wake_writer() noexcept {
     {

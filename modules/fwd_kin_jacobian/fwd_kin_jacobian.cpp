@@ -34,7 +34,7 @@ class FwdKinJacobian final : public Module {
  protected:
   Status init(InitContext& ctx) override {
     auto chain = load_chain(ctx.params());
-    if (!chain) return Status::fail(intern("fwd_kin_jacobian: " + chain.error().message));
+    if (!chain) return ctx.refuse("urdf", intern("fwd_kin_jacobian: " + chain.error().message));
     chain_ = std::move(chain).value();
     theta_m_ = ctx.in<double>("theta_m");
     x_m_ = ctx.out<double>("x_m");

@@ -46,7 +46,7 @@ class InvKin final : public Module {
   Status init(InitContext& ctx) override {
     const Params& p = ctx.params();
     auto chain = load_chain(p);
-    if (!chain) return Status::fail(intern("inv_kin: " + chain.error().message));
+    if (!chain) return ctx.refuse("urdf", intern("inv_kin: " + chain.error().message));
     chain_ = std::move(chain).value();
     const auto n = static_cast<std::size_t>(chain_->ndof());
 
@@ -64,9 +64,10 @@ class InvKin final : public Module {
     if (p.vector("lower").empty()) lower = urdf_lower;  // the URDF's, infinite for a continuous joint
     if (p.vector("upper").empty()) upper = urdf_upper;
     if (lower.size() != n || upper.size() != n)
-      return Status::fail("inv_kin: lower and upper need ndof (or 1) finite values");
+      return ctx.refuse(lower.size() != n ? "lower" : "upper",
+                        "inv_kin: lower and upper need ndof (or 1) finite values");
     for (std::size_t i = 0; i < n; ++i)
-      if (!(lower[i] <= upper[i])) return Status::fail("inv_kin: a lower joint limit is above its upper one");
+      if (!(lower[i] <= upper[i])) return ctx.refuse("lower", "inv_kin: a lower joint limit is above its upper one");
     solver_.emplace(*chain_, std::move(lower), std::move(upper), settings);
 
     x_d_ = ctx.in<double>("x_d");

@@ -52,20 +52,20 @@ class JoinWeightedAverage final : public Module {
     const Params& p = ctx.params();
     const double asked = p.number("inputs", 0.0);
     if (asked != 0.0 && (!(asked >= 2.0) || asked > kMaxInputs || asked != std::floor(asked)))
-      return Status::fail("join_weighted_average: inputs must be 0 or a whole number from 2 to 64");
+      return ctx.refuse("inputs", "join_weighted_average: inputs must be 0 or a whole number from 2 to 64");
     const int n = input_count(p);
     weights_ = p.vector("weights");
     if (weights_.empty()) weights_.assign(static_cast<std::size_t>(n), 1.0);
     if (weights_.size() != static_cast<std::size_t>(n))
-      return Status::fail(intern("join_weighted_average: " + std::to_string(weights_.size()) + " weights for " +
-                                 std::to_string(n) + " inputs"));
+      return ctx.refuse("weights", intern("join_weighted_average: " + std::to_string(weights_.size()) +
+                                          " weights for " + std::to_string(n) + " inputs"));
     double total = 0.0;
     for (const double w : weights_) {
       if (!(w >= 0.0) || !std::isfinite(w))
-        return Status::fail("join_weighted_average: weights must be >= 0 and finite");
+        return ctx.refuse("weights", "join_weighted_average: weights must be >= 0 and finite");
       total += w;
     }
-    if (!(total > 0.0)) return Status::fail("join_weighted_average: the weights must not all be 0");
+    if (!(total > 0.0)) return ctx.refuse("weights", "join_weighted_average: the weights must not all be 0");
 
     inputs_.clear();
     for (int i = 0; i < n; ++i) inputs_.push_back(ctx.in<double>(input_name(i)));

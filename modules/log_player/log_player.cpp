@@ -52,13 +52,14 @@ class LogPlayer final : public Module {
  protected:
   Status init(InitContext& ctx) override {
     const auto names = ctx.params().strings("variables");
-    if (names.empty()) return Status::fail("give variables: [names] to play");
+    if (names.empty()) return ctx.refuse("variables", "give variables: [names] to play");
     for (const auto& name : names) outs_.push_back(ctx.out<double>(name));
     if (ctx.failed()) return Status::ok();             // an unbound view already fails init, naming the port
     path_ = log_file_path(ctx.params().text("file"));  // where data_logger writes it
     from_s_ = ctx.params().number("from", 0.0);
     timing_ = &ctx.timing();
-    return read_log(names);
+    const Status read = read_log(names);
+    return read.is_ok() ? read : ctx.refuse("file", read.reason());
   }
 
   Status on() override {

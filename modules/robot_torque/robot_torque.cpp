@@ -33,7 +33,7 @@ class RobotTorque final : public Module {
     if (Status s = arm_.init(ctx, kName); !s.is_ok() || ctx.failed()) return s;
     const double bandwidth = ctx.params().number("hold_bandwidth", sim::kDefaultServoBandwidthHz);
     if (!(bandwidth > 0.0) || !std::isfinite(bandwidth))
-      return Status::fail("robot_torque: parameter hold_bandwidth must be > 0 Hz");
+      return ctx.refuse("hold_bandwidth", "robot_torque: parameter hold_bandwidth must be > 0 Hz");
     const sim::ServoGains hold = arm_.sim().servo_gains(bandwidth, sim::kDefaultServoMaxSpeed);
     if (auto set = arm_.sim().set_servo_gains(hold); !set)
       return Status::fail(intern("robot_torque: " + set.error().message));

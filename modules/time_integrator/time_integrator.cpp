@@ -38,7 +38,7 @@ class TimeIntegrator final : public Module {
     dt_ = ctx.period_s();
     if (!(dt_ > 0.0)) return Status::fail("time_integrator: the task must be periodic (it integrates over the period)");
     max_lead_ = p.number("max_lead", kDefaultMaxLead);
-    if (!(max_lead_ >= 0.0)) return Status::fail("time_integrator: max_lead must be >= 0 rad");
+    if (!(max_lead_ >= 0.0)) return ctx.refuse("max_lead", "time_integrator: max_lead must be >= 0 rad");
     if (max_lead_ == 0.0) max_lead_ = std::numeric_limits<double>::infinity();
 
     dtheta_d_ = ctx.in<double>("dtheta_d");
@@ -50,9 +50,11 @@ class TimeIntegrator final : public Module {
     lower_ = p.vector("lower").empty() ? Vector(n, -kInf) : per_joint(p, "lower", {}, n);
     upper_ = p.vector("upper").empty() ? Vector(n, kInf) : per_joint(p, "upper", {}, n);
     if (lower_.size() != n || upper_.size() != n)
-      return Status::fail("time_integrator: lower and upper need ndof (or 1) finite values");
+      return ctx.refuse(lower_.size() != n ? "lower" : "upper",
+                        "time_integrator: lower and upper need ndof (or 1) finite values");
     for (std::size_t i = 0; i < n; ++i)
-      if (!(lower_[i] <= upper_[i])) return Status::fail("time_integrator: a lower bound is above its upper one");
+      if (!(lower_[i] <= upper_[i]))
+        return ctx.refuse("lower", "time_integrator: a lower bound is above its upper one");
     start_from_measurement();
     return Status::ok();
   }

@@ -28,7 +28,9 @@ class TorqueLimit final : public Module {
     d.out_var("tau_out", Dim::of("ndof"), "joint torques clamped to +-limit, N*m");
     d.param("limit", default_limit(), "N*m", "torque limit per joint (or one for all)").at_least(0);
     d.param("late_limit", kDefaultLateLimit, "cycles",
-            "timing faults (late cycles, budget overruns) in a row that error() recovers from before ERROR").whole().at_least(1);
+            "timing faults (late cycles, budget overruns) in a row that error() recovers from before ERROR")
+        .whole()
+        .at_least(1);
   }
 
  protected:
@@ -38,7 +40,7 @@ class TorqueLimit final : public Module {
     if (ctx.failed()) return Status::ok();  // an unbound view already fails init, naming the port
     limit_ = per_joint(ctx.params(), "limit", default_limit(), out_.size());
     if (limit_.empty() || !all_non_negative(limit_))
-      return Status::fail("torque_limit: limit needs ndof (or 1) values, none negative");
+      return ctx.refuse("limit", "torque_limit: limit needs ndof (or 1) values, none negative");
     timing_ = &ctx.timing();
     tolerance_ = TimingFaultTolerance(
         static_cast<std::uint64_t>(std::max(1.0, ctx.params().number("late_limit", kDefaultLateLimit))));

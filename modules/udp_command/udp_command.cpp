@@ -56,13 +56,13 @@ class UdpCommand final : public Module {
     const Params& p = ctx.params();
     const double size = p.number("size", kDefaultSize);
     if (!(size >= 1 && size <= kMaxSize) || size != std::floor(size))
-      return Status::fail("udp_command: size must be a whole number from 1 to 256");
+      return ctx.refuse("size", "udp_command: size must be a whole number from 1 to 256");
     const double cost = p.number("cost");
-    if (!(cost >= 0)) return Status::fail("udp_command: cost must be >= 0 s");
+    if (!(cost >= 0)) return ctx.refuse("cost", "udp_command: cost must be >= 0 s");
     cost_ns_ = static_cast<std::int64_t>(std::llround(cost * 1e9));
 
     const UdpSocket socket = bind_udp(p.text("address", "127.0.0.1"), p.number("port"));
-    if (socket.fd < 0) return Status::fail(socket.error);
+    if (socket.fd < 0) return ctx.refuse("port", socket.error);
     fd_ = socket.fd;
 
     command_ = ctx.out<double>("command");

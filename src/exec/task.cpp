@@ -21,6 +21,15 @@ const char* hook_name(std::uint8_t hook) {
                                                         "error", "clear", "reinit", "sync"};
   return kNames[hook];
 }
+
+// "file:line: key: init failed: why", at the parameter init refused if it named one, else at the
+// task; as the loader's messages read, so that every refusal of a file points into it.
+std::string init_failure_message(const TaskSpec& spec, const std::string& param, const std::string& reason) {
+  const SourceLoc at = param.empty() ? spec.loc : spec.loc_of_param(param);
+  const std::string key = param.empty() ? spec.name : fmt::format("{}.params.{}", spec.name, param);
+  if (at.file.empty() || at.line <= 0) return fmt::format("{}: init failed: {}", key, reason);
+  return fmt::format("{}:{}: {}: init failed: {}", at.file, at.line, key, reason);
+}
 }  // namespace
 
 const char* busy_in_name(BusyIn method) noexcept {
@@ -335,7 +344,7 @@ Result<void> Task::spawn(std::int64_t now_ns) {
     (void)call_raw(Hook::kKill);
     destroy_module();
     shared_->events.push(now_ns, "init failed; task not created: ", reason.c_str());
-    return make_error(Errc::kModuleFault, fmt::format("{}: init failed: {}", spec_.name, reason));
+    return make_error(Errc::kModuleFault, init_failure_message(spec_, ctx.refused_param(), reason));
   }
   // Publishing what init produced lets consumers start from real values; not while another
   // producer of these variables is ON (a task created in the background for a switch): one

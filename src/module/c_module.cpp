@@ -228,6 +228,9 @@ void chimera_param_one_of(chimera_decl* d, const char* name, const char* const* 
   for (size_t i = 0; choices != nullptr && i < count; ++i) list.emplace_back(text_or_empty(choices[i]));
   if (auto r = rule_for(d, name, "chimera_param_one_of")) r->one_of(std::move(list));
 }
+void chimera_param_whole(chimera_decl* d, const char* name) {
+  if (auto r = rule_for(d, name, "chimera_param_whole")) r->whole();
+}
 void chimera_resource(chimera_decl* d, const char* what) { decl_of(d).resource(text_or_empty(what)); }
 
 double chimera_number(const chimera_params* p, const char* name, double fallback) {
@@ -272,6 +275,12 @@ const chimera_params* chimera_ctx_params(const chimera_ctx* ctx) { return &ctx->
 const char* chimera_task_name(const chimera_ctx* ctx) { return ctx->task_name.c_str(); }
 const chimera_timing* chimera_timing_of(const chimera_ctx* ctx) { return &ctx->timing; }
 double chimera_period_s(const chimera_ctx* ctx) { return static_cast<double>(ctx->timing.period_ns) * 1e-9; }
+chimera_status chimera_refuse(chimera_ctx* ctx, const char* param, chimera_status reason) {
+  const chimera_status why = reason != nullptr ? reason : "refused";
+  if (ctx == nullptr || ctx->init == nullptr || param == nullptr) return why;  // not in init: only the reason
+  return ctx->init->refuse(param, why).reason();
+}
+
 int chimera_illegal_configuration(const chimera_ctx* ctx) {
   return static_cast<int>(ctx->flags->illegal_configuration());
 }

@@ -59,6 +59,13 @@ struct TaskSpec {
   /// process itself, unless the file names a module process.
   std::string process{kMainProcess};
   SourceLoc loc;
+  std::map<std::string, int> param_lines;  // the line of each parameter the file gives
+
+  /// Where parameter `param` is written: its line, or the task's if the file leaves it default.
+  [[nodiscard]] SourceLoc loc_of_param(const std::string& param) const {
+    auto it = param_lines.find(param);
+    return it == param_lines.end() ? loc : SourceLoc{loc.file, it->second};
+  }
 
   /// The variable that port `port` is bound to after renaming.
   [[nodiscard]] std::string variable_of(const std::string& port) const {

@@ -101,6 +101,8 @@ void chimera_param_greater_than(chimera_decl* d, const char* name, double lower)
 void chimera_param_at_most(chimera_decl* d, const char* name, double upper);
 void chimera_param_less_than(chimera_decl* d, const char* name, double upper);
 void chimera_param_one_of(chimera_decl* d, const char* name, const char* const* choices, size_t count);
+/* Whole numbers only (counts, sizes, ports): 2.5 is refused at its line. */
+void chimera_param_whole(chimera_decl* d, const char* name);
 /* What the module's resource port talks to (hardware, a simulation, a socket), for docs. */
 void chimera_resource(chimera_decl* d, const char* what);
 
@@ -144,6 +146,10 @@ const char* chimera_task_name(const chimera_ctx* ctx);
 const chimera_timing* chimera_timing_of(const chimera_ctx* ctx);
 /* Period in seconds, 0 for an aperiodic task. */
 double chimera_period_s(const chimera_ctx* ctx);
+/* In init: refuse parameter `param`'s value; returns `reason` for init to return. The framework's
+ * message then points at the line of the subsystem file that gives the parameter (or the task's,
+ * if the file leaves it at its default): "robot.yaml:12: arm.params.model: init failed: ...". */
+chimera_status chimera_refuse(chimera_ctx* ctx, const char* param, chimera_status reason);
 /* The paper's illegal-configuration flag (section 3.4); keep ctx to ask in cycle. Real-time safe. */
 int chimera_illegal_configuration(const chimera_ctx* ctx);
 

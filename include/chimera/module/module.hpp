@@ -178,8 +178,17 @@ class InitContext {
   /// Period in seconds (0 for aperiodic tasks).
   [[nodiscard]] double period_s() const { return static_cast<double>(timing_.period_ns) * 1e-9; }
 
+  /// Init's refusal of parameter `param`'s value (`reason` as for Status::fail): the framework's
+  /// message then points at the line of the subsystem file that gives it, or the task's line.
+  Status refuse(std::string_view param, const char* reason) {
+    refused_param_ = std::string(param);
+    return Status::fail(reason);
+  }
+
   [[nodiscard]] bool failed() const { return !binding_error_.empty(); }
   [[nodiscard]] const std::string& binding_error() const { return binding_error_; }
+  /// The parameter named by refuse(), "" if none.
+  [[nodiscard]] const std::string& refused_param() const { return refused_param_; }
 
  private:
   void note_failure(const std::string& message) {
@@ -194,6 +203,7 @@ class InitContext {
   Trigger& trigger_;
   TaskServices services_;
   std::string binding_error_;
+  std::string refused_param_;
 };
 
 class Task;

@@ -39,9 +39,10 @@ Result<void> read_timing(const Source& source, const MapReader& map, TaskSpec& t
     if (!ns) return ns.error();
     if (*ns <= 0) return source.fail(f, "must be greater than zero");
     if (*ns < kShortestPeriodNs)
-      return source.fail(f, fmt::format("{}{} is shorter than {}, the shortest period a task can be released at",
-                                        f.node.Scalar(), period ? "" : fmt::format(" (a period of {})", format_period(*ns)),
-                                        format_period(kShortestPeriodNs)));
+      return source.fail(
+          f, fmt::format("{}{} is shorter than {}, the shortest period a task can be released at", f.node.Scalar(),
+                         period ? "" : fmt::format(" (a period of {})", format_period(*ns)),
+                         format_period(kShortestPeriodNs)));
     task.period_ns = *ns;
   }
   task.deadline_ns = task.period_ns.value_or(0);  // an aperiodic task without a deadline has none (0)
@@ -171,8 +172,10 @@ void fit_empty_list(ParamValue& v, ParamType declared) {
   if (declared == ParamType::kStringList) v = StringList{};
 }
 
-// Checks `params:` against the module's declared parameters and fills in the defaults.
-Result<Params> read_params(const Source& source, const std::optional<Field>& field, const ModuleInfo& info) {
+// Checks `params:` against the module's declared parameters and fills in the defaults. `lines`
+// gets the line of each parameter given, for init's refusals to point at.
+Result<Params> read_params(const Source& source, const std::optional<Field>& field, const ModuleInfo& info,
+                           std::map<std::string, int>& lines) {
   const Declarations declared = info.declarations(Params{});
   Params params;
   if (field) {
@@ -200,6 +203,7 @@ Result<Params> read_params(const Source& source, const std::optional<Field>& fie
       if (auto why = rule_violation(decl->rule, *v); !why.empty())
         return source.fail(value, fmt::format("{} given: {}", to_string(*v), why));
       params.set(name, *std::move(v));
+      lines[name] = value.line;
     }
   }
   for (const auto& p : declared.params())
@@ -282,7 +286,7 @@ Result<TaskSpec> load_task(const Source& source, const Field& task_field, const 
     if (!process_name) return process_name.error();
     task.process = *std::move(process_name);
   }
-  auto params = read_params(source, map->get("params"), **info);
+  auto params = read_params(source, map->get("params"), **info, task.param_lines);
   if (!params) return params.error();
   task.params = *std::move(params);
   if (const auto rename = map->get("rename")) {

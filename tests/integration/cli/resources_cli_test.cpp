@@ -38,7 +38,8 @@ bool contains(const std::string& text, const std::string& part) { return text.fi
 
 // A subsystem of built-in modules whose table is a few kilobytes, with a data logger. Every task
 // is soft: a real-clock run on a loaded machine may miss deadlines, which must not end it.
-std::string subsystem_file(const std::string& name, const std::string& log_file) {
+// The log's parameters are on line 10, its task at line 6; `more` adds to them.
+std::string subsystem_file(const std::string& name, const std::string& log_file, const std::string& more = {}) {
   return "subsystem: " + name +
          "\n"
          "tasks:\n"
@@ -50,7 +51,7 @@ std::string subsystem_file(const std::string& name, const std::string& log_file)
          "    period: 1ms\n"
          "    criticality: soft\n"
          "    params: { variables: [theta_d, theta_m, dtheta_m, tau_r], file: " +
-         log_file + " }\n";
+         log_file + more + " }\n";
 }
 
 // Runs a shell script in a mount namespace of its own (as root, or as a user mapped to root where
@@ -139,9 +140,10 @@ class ResourcesCliTest : public ::testing::Test {
   std::string name(const std::string& what) {
     return "res_" + what + "_" + std::to_string(::getpid()) + "_" + std::to_string(count_++);
   }
-  std::string file(const std::string& subsystem, const std::string& log_file = "log.csv") {
+  std::string file(const std::string& subsystem, const std::string& log_file = "log.csv",
+                   const std::string& more = {}) {
     const std::string path = dir_.file(subsystem + ".yaml");
-    write_text(path, subsystem_file(subsystem, log_file));
+    write_text(path, subsystem_file(subsystem, log_file, more));
     return path;
   }
   Outcome chimera(const std::string& args, const std::string& prefix = {}) {
@@ -184,9 +186,45 @@ TEST_F(ResourcesCliTest, AFullDevShmIsOneMessageAndExit2NeverSigbus) {
 
 TEST_F(ResourcesCliTest, ALogOnDevFullIsRefusedBeforeTheRunStarts) {
   const std::string n = tracked(name("devfull"));
-  const auto o = chimera("run " + quoted(file(n, "/dev/full")) + " --clock virtual --for 100ms");
+  const std::string f = file(n, "/dev/full");
+  const auto o = chimera("run " + quoted(f) + " --clock virtual --for 100ms");
   EXPECT_EXIT_CODE(o, 2);
-  EXPECT_TRUE(contains(o.err, "log: init failed: cannot write the log /dev/full: No space left on device")) << o.err;
+  // At the line of the parameter init refused, as the loader's messages are.
+  EXPECT_TRUE(
+      contains(o.err, f + ":10: log.params.file: init failed: cannot write the log /dev/full: No space left on device"))
+      << o.err;
+  EXPECT_FALSE(std::filesystem::exists(region_path(n)));
+}
+
+// `capacity` counts rows, the variables set their width: a ring past 1 GiB is refused at the
+// parameter's line, by run and by analyze's measuring run alike, never a bad_alloc.
+TEST_F(ResourcesCliTest, ALoggerRingPastItsMemoryBoundIsRefusedAtItsLineByRunAndAnalyze) {
+  const std::string n = tracked(name("bigring"));
+  const std::string f = file(n, "log.csv", ", capacity: 1e8");
+  const std::string said = f +
+                           ":10: log.params.capacity: init failed: 100000000 rows of 25 values take 19073 MiB, "
+                           "past the ring's 1024 MiB: at most 5368709 rows";
+  const auto run = chimera("run " + quoted(f) + " --clock virtual --for 100ms");
+  EXPECT_EXIT_CODE(run, 2);
+  EXPECT_TRUE(contains(run.err, said)) << run.err;
+  const auto analyze = chimera("analyze " + quoted(f));
+  EXPECT_EXIT_CODE(analyze, 2);
+  EXPECT_TRUE(analyze.err.starts_with(said)) << analyze.err;
+  EXPECT_FALSE(std::filesystem::exists(region_path(n)));
+}
+
+// A writer that falls behind loses rows as surely as a full disk: the run must not end as if
+// its log were whole. A ring of 16 rows at 1 kHz, drained every 20 ms, cannot keep up.
+TEST_F(ResourcesCliTest, ALoggerWhoseRingOverflowsOnTheRealClockEndsTheRunWith1AndTheCount) {
+  const std::string n = tracked(name("overflow"));
+  const auto o = chimera("run " + quoted(file(n, "log.csv", ", capacity: 16")) + " --clock real --for 500ms");
+  EXPECT_EXIT_CODE(o, 1);
+  ASSERT_FALSE(o.err.empty());
+  const std::string last = o.err.substr(o.err.rfind('\n', o.err.size() - 2) + 1);
+  EXPECT_TRUE(last.starts_with("chimera: exit 1: task log: kill failed: ")) << o.err;
+  EXPECT_TRUE(contains(last, " rows lost: not logged to " + dir_.file("log.csv") +
+                                 ", the ring of 16 rows was full (the writer fell behind: raise capacity)"))
+      << last;
   EXPECT_FALSE(std::filesystem::exists(region_path(n)));
 }
 

@@ -24,6 +24,7 @@ static void counter_declare(chimera_decl* d, const chimera_params* p) {
   chimera_param_number(d, "offset", 0.0, "", "added to the count");
   chimera_param_number(d, "width", 3.0, "", "size of seen (at least 3)");
   chimera_param_at_least(d, "width", 3.0); /* a rule chimera verify checks, with the file's line */
+  chimera_param_whole(d, "width");
   chimera_param_number(d, "fail_at", -1.0, "cycles", "cycle that fails (-1: none)");
   chimera_param_bool(d, "recover", 0, "", "error() recovers");
   chimera_param_string(d, "label", "counter", "", "a text parameter");
@@ -50,7 +51,7 @@ static chimera_status counter_init(void* self, chimera_ctx* ctx) {
   s->offset = chimera_number(p, "offset", 0.0);
   s->fail_at = chimera_number(p, "fail_at", -1.0);
   s->recover = chimera_flag(p, "recover", 0);
-  if (label == NULL || strcmp(label, "refuse") == 0) return "label says refuse";
+  if (label == NULL || strcmp(label, "refuse") == 0) return chimera_refuse(ctx, "label", "label says refuse");
   if (chimera_vector(p, "gains", gains, 4) != 2 || gains[1] != 2.0) return "gains are not [1, 2]";
   if (strcmp(chimera_task_name(ctx), "") == 0) return "no task name";
   if (s->seen.size < 3) return "width must be at least 3";
