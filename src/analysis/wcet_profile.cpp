@@ -6,13 +6,13 @@
 #include <cerrno>
 #include <cmath>
 #include <fstream>
-#include <sstream>
 #include <system_error>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
 #include "chimera/core/duration_text.hpp"
+#include "config/detail/file_text.hpp"
 #include "config/detail/yaml_reader.hpp"
 
 namespace chimera::analysis {
@@ -131,14 +131,10 @@ Result<WcetProfile> read_wcet_profile_text(std::string_view text, const std::str
 }
 
 Result<WcetProfile> read_wcet_profile_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in)
-    return make_error(Errc::kInvalidInput,
-                      fmt::format("{}: cannot open the profile ({})", path, std::generic_category().message(errno)));
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) return make_error(Errc::kInvalidInput, fmt::format("{}: cannot read the profile", path));
-  return read_wcet_profile_text(text.str(), path);
+  // As a subsystem file is read: a FIFO, a device or gigabytes are refused, never waited on.
+  auto text = config_detail::read_file_text(path, "profile");
+  if (!text) return text.error();
+  return read_wcet_profile_text(*text, path);
 }
 
 std::string format_wcet_profile(const WcetProfile& profile) {

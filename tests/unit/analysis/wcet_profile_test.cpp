@@ -3,6 +3,9 @@
 
 #include "chimera/analysis/wcet_profile.hpp"
 
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -99,6 +102,21 @@ TEST(WcetProfile, WritesAndReadsAFile) {
   const auto missing = read_wcet_profile_file("/nonexistent_dir/p.yaml");
   ASSERT_FALSE(missing);
   EXPECT_EQ(missing.error().message.rfind("/nonexistent_dir/p.yaml: cannot open the profile", 0), 0U);
+}
+
+// A profile is read as a subsystem file is: a FIFO with no writer would block analyze forever,
+// /dev/zero would be read without end.
+TEST(WcetProfile, OnlyARegularFileOfBoundedSizeIsRead) {
+  const std::string fifo =
+      (std::filesystem::temp_directory_path() / ("chimera_wcet_profile_fifo_" + std::to_string(::getpid()))).string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const auto from_fifo = read_wcet_profile_file(fifo);
+  std::remove(fifo.c_str());
+  ASSERT_FALSE(from_fifo);
+  EXPECT_EQ(from_fifo.error().message, fifo + ": is a FIFO, not a profile (only regular files are read)");
+  const auto from_zero = read_wcet_profile_file("/dev/zero");
+  ASSERT_FALSE(from_zero);
+  EXPECT_EQ(from_zero.error().message, "/dev/zero: is a character device, not a profile (only regular files are read)");
 }
 
 std::string error_of(const std::string& text) {

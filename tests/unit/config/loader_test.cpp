@@ -299,7 +299,7 @@ TEST(LoadSubsystemFile, MissingFileSaysSo) {
   auto r = load_subsystem_file(kData + "/no_such_file.yaml", registry());
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.error().code, Errc::kInvalidInput);
-  EXPECT_EQ(r.error().message, kData + "/no_such_file.yaml: cannot open the file (No such file or directory)");
+  EXPECT_EQ(r.error().message, kData + "/no_such_file.yaml: cannot open the subsystem file (No such file or directory)");
 }
 
 TEST(LoadSubsystemFile, DirectoryIsRefused) {
