@@ -48,9 +48,10 @@ ModuleProcess::~ModuleProcess() {
   if (unwatched_fd_ >= 0) ::close(unwatched_fd_);
 }
 
-int ModuleProcess::take_watch(std::uint64_t& generation) {
+int ModuleProcess::take_watch(std::uint64_t& generation, pid_t& pid) {
   std::lock_guard<std::mutex> lock(watch_mutex_);
   generation = unwatched_generation_;
+  pid = unwatched_pid_;
   return std::exchange(unwatched_fd_, -1);
 }
 
@@ -126,6 +127,7 @@ Result<void> ModuleProcess::start(const WorkerLaunch& launch) {
     if (unwatched_fd_ >= 0) ::close(unwatched_fd_);  // a start that ended before the supervisor took it
     unwatched_fd_ = ::fcntl(pidfd(), F_DUPFD_CLOEXEC, 0);
     unwatched_generation_ = generation;
+    unwatched_pid_ = pid;
   }
   state_.store(State::kRunning, std::memory_order_release);  // release: the fds are set for the supervisor
   ProcessReply ready;

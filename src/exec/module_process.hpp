@@ -70,9 +70,9 @@ class ModuleProcess {
   std::string stop();
 
   /// The supervisor's own pidfd of the process started last (a duplicate, which names that
-  /// process and no other for as long as it is open), and that start's number; -1 when taken
-  /// already. The caller owns the descriptor. Any thread.
-  int take_watch(std::uint64_t& generation);
+  /// process and no other for as long as it is open), that start's number and its pid; -1 when
+  /// taken already. The caller owns the descriptor. Any thread.
+  int take_watch(std::uint64_t& generation, pid_t& pid);
   /// Which start of the process it is (1 for the first); changes only under `mutex`.
   [[nodiscard]] std::uint64_t generation() const noexcept { return generation_.load(std::memory_order_acquire); }
   /// The supervisor is about to kill start `generation` of the process, for `reason`: the end
@@ -108,6 +108,7 @@ class ModuleProcess {
   mutable std::mutex watch_mutex_;
   int unwatched_fd_ = -1;
   std::uint64_t unwatched_generation_ = 0;
+  pid_t unwatched_pid_ = -1;
   std::uint64_t killed_generation_ = 0;
   std::string kill_reason_;
 };

@@ -28,6 +28,22 @@ namespace chimera {
 
 namespace {
 
+// The state letter of /proc/PID/stat ('R', 'S', 'T' stopped, 't' traced, 'Z'...), or 0 if it
+// cannot be read (the process is gone). The name in parentheses may hold anything, ')' too.
+char process_state(pid_t pid) {
+  std::array<char, 512> buffer{};
+  const std::string path = fmt::format("/proc/{}/stat", pid);
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);  // NOLINT(*-vararg)
+  if (fd < 0) return 0;
+  const ssize_t n = ::read(fd, buffer.data(), buffer.size() - 1);
+  ::close(fd);
+  if (n <= 0) return 0;
+  const std::string_view text(buffer.data(), static_cast<std::size_t>(n));
+  const auto name_end = text.rfind(')');
+  if (name_end == std::string_view::npos || name_end + 2 >= text.size()) return 0;
+  return text[name_end + 2];
+}
+
 ProcessCommand command_for(ProcessCommandKind kind, std::size_t task, Signal signal = Signal::kSpawn) {
   ProcessCommand c;
   c.kind = kind;
@@ -354,8 +370,8 @@ void ProcessExecutive::supervise() {
   std::vector<pollfd> fds;
   while (!stopping_.load(std::memory_order_acquire)) {  // acquire: pairs with shutdown()
     for (auto& p : processes_) {
-      Watch w{p.get(), 0, -1, false};
-      w.pidfd = p->take_watch(w.generation);
+      Watch w{p.get(), 0, -1, false, -1};
+      w.pidfd = p->take_watch(w.generation, w.pid);
       if (w.pidfd >= 0) watches.push_back(w);
     }
     fds.assign(1, pollfd{wake_fd_, POLLIN, 0});
@@ -384,6 +400,30 @@ void ProcessExecutive::supervise() {
   for (const Watch& w : watches) ::close(w.pidfd);
 }
 
+void ProcessExecutive::check_stopped(Watch& w, std::int64_t now_ns) {
+  if (w.pid <= 0) return;
+  if (process_state(w.pid) != 'T') {
+    w.stopped_since_ns = -1;
+    return;
+  }
+  if (w.stopped_since_ns < 0) {
+    w.stopped_since_ns = now_ns;
+    return;
+  }
+  std::int64_t bound = StuckBound::kMethodNs;
+  for (const std::size_t i : w.process->tasks()) bound = std::min(bound, stuck_bound_ns(*tasks_[i], BusyIn::kCycle));
+  const std::int64_t stopped = now_ns - w.stopped_since_ns;
+  if (stopped <= bound) return;
+  const std::string reason =
+      fmt::format("stopped by a signal for {:.0f} ms, its tasks running nothing", static_cast<double>(stopped) / 1e6);
+  w.process->note_kill(w.generation, reason);
+  // SIGKILL ends a stopped process too (SIGCONT is not needed), by the supervisor's own pidfd.
+  ::syscall(SYS_pidfd_send_signal, w.pidfd, SIGKILL, nullptr, 0);
+  w.killed = true;
+  if (events_ != nullptr)
+    events_->add(Event{now_ns, "", fmt::format("process {}: {}; killed", w.process->name(), reason)});
+}
+
 std::int64_t ProcessExecutive::stuck_bound_ns(const Task& task, BusyIn method) {
   return StuckBound::of(method, task.period_ns(), task.spec().deadline_ns);
 }
@@ -391,6 +431,7 @@ std::int64_t ProcessExecutive::stuck_bound_ns(const Task& task, BusyIn method) {
 void ProcessExecutive::check_heartbeats(std::vector<Watch>& watches) {
   const std::int64_t now = now_ns();
   for (Watch& w : watches) {
+    if (!w.killed) check_stopped(w, now);
     if (w.killed) continue;
     for (const std::size_t i : w.process->tasks()) {
       const TaskShared& slot = *block_->slot(i);

@@ -71,8 +71,14 @@ class ProcessExecutive final : public Executive {
     ModuleProcess* process;
     std::uint64_t generation;
     int pidfd;
-    bool killed;  // for a stuck task: its end is on the way
+    bool killed;                         // for a stuck task: its end is on the way
+    pid_t pid;                           // to read its state in /proc; signals go by the pidfd
+    std::int64_t stopped_since_ns = -1;  // first seen stopped (SIGSTOP), -1 while it runs
   };
+  /// A process stopped by a signal (SIGSTOP, SIGTSTP) runs none of its tasks, yet no heartbeat
+  /// says so between methods: past the stuck bound of its shortest period it is killed, as a stuck
+  /// task's is. A debugger's stop (traced) is left alone.
+  void check_stopped(Watch& w, std::int64_t now_ns);
   /// How often the supervisor reads the heartbeats; a task inside one method longer than
   /// StuckBound (task_shared.hpp) is stuck.
   static constexpr int kHeartbeatTickMs = 10;
@@ -97,7 +103,7 @@ class ProcessExecutive final : public Executive {
   std::thread supervisor_;
   std::mutex watchers_mutex_;
   std::vector<std::thread> watchers_;  // one per start of a module process, joined at shutdown
-  bool stopped_ = false;  // the control thread's
+  bool stopped_ = false;               // the control thread's
 };
 
 }  // namespace chimera

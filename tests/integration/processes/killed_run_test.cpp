@@ -1,7 +1,8 @@
 // A subsystem with module processes whose run was killed (issue 15, item 3) starts again at once,
 // with nothing removed by hand: after SIGKILL of every process (the main one and its workers), and
 // after SIGKILL of the main process alone, whose workers then end by themselves. The test is the
-// workers' subreaper, so that it sees them end and reaps them, whoever their parent was.
+// workers' subreaper, so that it sees them end and reaps them, whoever their parent was. And a
+// worker stopped by SIGSTOP between its cycles, which no heartbeat shows: its tasks go to ERROR.
 
 #include <signal.h>
 #include <sys/prctl.h>
@@ -130,6 +131,49 @@ TEST_F(KilledRunTest, MainProcessKilledItsWorkersEndByThemselves) {
     for (const pid_t w : workers) EXPECT_TRUE(reap_within_bound(w)) << "worker " << w << " outlived its run";
   }
   starts_again_and_quits();
+}
+
+// SIGSTOP between two cycles: no task is inside a method, so no heartbeat runs long, yet the
+// worker runs nothing. The supervisor sees it stopped past the stuck bound (200 ms here) and kills
+// it, as a stuck task's process: its task is in ERROR with the reason, the rest runs on, and clear
+// brings it back in a new worker.
+TEST_F(KilledRunTest, AWorkerStoppedBySigstopIsKilledAndItsTaskGoesToError) {
+  ChimeraProcess run(dir_, {"run", path_});
+  const auto workers = wait_for_worker(run, run.pid(), name_);
+  ASSERT_EQ(workers.size(), 1U) << run.err();
+  // Running, not starting (a worker stopped before it is ready is the start's own time-out).
+  run.send("status\n");
+  bool running = false;
+  for (int i = 0; i < 3000 && !running; ++i) {
+    running = run.out().find("traj ") != std::string::npos;
+    if (!running) std::this_thread::sleep_for(10ms);
+  }
+  ASSERT_TRUE(running) << run.err();
+  ASSERT_EQ(::kill(workers[0], SIGSTOP), 0);
+  const std::string said = "traj: ERROR: its process planner died (killed by the supervisor: stopped by a signal for ";
+  bool seen = false;
+  for (int i = 0; i < 3000 && !seen; ++i) {  // a liveness bound, not a timing figure
+    seen = run.err().find(said) != std::string::npos;
+    if (!seen) std::this_thread::sleep_for(10ms);
+  }
+  EXPECT_TRUE(seen) << run.err();
+  EXPECT_NE(run.err().find("process planner: stopped by a signal for "), std::string::npos) << run.err();
+  EXPECT_TRUE(reap_within_bound(workers[0])) << "the stopped worker was not killed";
+  run.send("status\nclear traj\non traj\nstatus\nquit\n");
+  EXPECT_EQ(run.wait_exit(), 0) << run.err();
+  const std::string out = run.out();
+  // The status after the stop: traj in ERROR; the last: traj ON again (its last error kept, as
+  // what was cleared).
+  std::vector<std::string> states;  // traj's state in each status, in order
+  std::istringstream lines(run.out());
+  for (std::string line; std::getline(lines, line);) {
+    std::istringstream cells(line);
+    std::string task, module, state;
+    if (cells >> task >> module >> state && task == "traj" && module == "joint_traj_gen") states.push_back(state);
+  }
+  // Three statuses and the closing table.
+  EXPECT_EQ(states, (std::vector<std::string>{"ON", "ERROR", "ON", "ON"})) << run.out();
+  for (const pid_t w : children_of(run.pid())) EXPECT_TRUE(reap_within_bound(w)) << "worker " << w;
 }
 
 }  // namespace
