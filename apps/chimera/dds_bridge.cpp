@@ -62,6 +62,23 @@ std::vector<std::string> DdsBridge::news() {
   return lines;
 }
 
+std::vector<RemoteImport> DdsBridge::imports() const {
+  std::vector<RemoteImport> out;
+  if (ports_ == nullptr) return out;
+  for (const auto& status : ports_->imports()) {
+    RemoteImport& i = out.emplace_back();
+    i.variable = status.variable;
+    i.writer = status.writer;
+    i.samples = status.samples;
+    i.refused = status.refused;
+    i.age_ns = status.age_ns;
+    i.stale = status.stale;
+    i.refusal = status.refusal;
+    i.max_age_ns = status.max_age_ns;
+  }
+  return out;
+}
+
 std::vector<std::string> DdsBridge::stop() {
   std::vector<std::string> lines;
   if (ports_ != nullptr) lines = ports_->take_errors();

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "chimera/config/subsystem.hpp"
+#include "chimera/control/remote_imports.hpp"
 #include "chimera/control/subsystem.hpp"
 #include "chimera/core/result.hpp"
 #include "chimera/dds/remote_ports.hpp"
@@ -37,6 +38,9 @@ class DdsBridge {
   /// What the bridge has to say (an import stale or fresh again, a remote refused), one line each
   /// without "dds: ". Any time; the run's loop asks every 50 ms.
   std::vector<std::string> news();
+  /// Each import of the file the bridge follows, as `status` shows it (none while idle). From the
+  /// thread that drives the commands, or under the gate.
+  [[nodiscard]] std::vector<RemoteImport> imports() const;
   /// The bridge's last errors; then it stops (it writes no import after this).
   std::vector<std::string> stop();
 

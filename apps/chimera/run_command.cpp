@@ -235,6 +235,8 @@ int run_command(const RunArgs& args) {
     }
     remote = std::move(*bridge);
   }
+  // `status` shows the imports beside the tasks (the shell's and the network API's).
+  subsystem.report_remote_imports([bridge = remote.get()] { return bridge->imports(); });
 
   const bool interactive = ::isatty(STDIN_FILENO) == 1;
   if (interactive)
@@ -254,6 +256,7 @@ int run_command(const RunArgs& args) {
   Session session(subsystem, gate, remote.get(), args, interactive);
   session.run();
   network.reset();  // the network API ends before the subsystem stops
+  subsystem.report_remote_imports({});  // no command runs any more: the bridge can go
   if (remote) {
     for (const auto& line : remote->stop()) err("dds: " + line + "\n");  // it writes no import after this
     remote.reset();                                                      // before the tasks stop

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "chimera/control/remote_imports.hpp"
 #include "chimera/control/task_profile.hpp"
 #include "chimera/control/timing_table.hpp"
 #include "reply_text.hpp"
@@ -58,6 +59,9 @@ Reply Control::execute(const Command& command) {
     switch (command.verb) {
       case Verb::kStatus: {
         std::string text = status_table(subsystem_.snapshot());
+        // The variables other subsystems feed (docs/dds.md): whether each is fresh, and from whom.
+        if (const auto imports = subsystem_.remote_imports(); !imports.empty())
+          text += "\n" + remote_imports_table(imports);
         // The flag is what makes the robot interfaces hold the arm (paper 3.4): say when it is up.
         if (subsystem_.illegal_configuration())
           text += "illegal-configuration flag raised: the robot interfaces hold the arm\n";

@@ -317,6 +317,13 @@ bool Subsystem::illegal_configuration() const {
   return impl_->table && impl_->table->illegal_configuration();
 }
 
+void Subsystem::report_remote_imports(RemoteImportsReport report) { impl_->remote_imports = std::move(report); }
+
+std::vector<RemoteImport> Subsystem::remote_imports() const {
+  if (!impl_->remote_imports) return {};
+  return impl_->remote_imports();
+}
+
 Result<void> Subsystem::watch_writes(const std::string& variable, std::shared_ptr<WriteWatch> watch) {
   Impl& m = *impl_;
   std::lock_guard<std::mutex> lock(m.ops_mutex);

@@ -72,6 +72,8 @@ struct Subsystem::Impl {
   // watch_writes(): each variable's watch, applied to every executive build_runtime() makes.
   std::vector<std::pair<std::string, std::shared_ptr<WriteWatch>>> watches;
   bool earlier_hard_failure = false;
+  // report_remote_imports(): set and called from the thread that drives the commands.
+  RemoteImportsReport remote_imports;
   // build_runtime()'s count. Release after the table is made, acquire by runtimes_built(): who
   // sees the new count finds the new region under the table's name.
   std::atomic<std::uint64_t> runtimes_built{0};

@@ -5,10 +5,14 @@
 
 #include "chimera/dds/remote_ports.hpp"
 
+#include <poll.h>
+#include <sys/eventfd.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
-#include <array>
 #include <deque>
 #include <limits>
 #include <mutex>
@@ -17,10 +21,8 @@
 #include <thread>
 
 #include <dds/dds.h>
-#include <poll.h>
-#include <sys/eventfd.h>
-#include <unistd.h>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "chimera/core/duration_text.hpp"
 #include "chimera/svt/global_table.hpp"
@@ -119,6 +121,9 @@ struct RemotePorts::Impl {
   std::deque<ImportPort> imports;
   dds_entity_t waitset = 0;
   dds_entity_t wake = 0;  // a guard condition that ends the taker's wait at shutdown
+  // The builtin topic of every writer discovered, with imports: one of another type on an
+  // import's topic is named (check_publication). Its attach id is the waitset's last.
+  dds_entity_t publications = 0;
 
   std::atomic<bool> stopping{false};
   int stop_fd = -1;  // an eventfd: the destructor ends the publisher's sleep with it
@@ -127,11 +132,11 @@ struct RemotePorts::Impl {
 
   mutable std::mutex status_mutex;  // imports[i].status, errors, changes, reported
   std::vector<std::string> errors;
-  std::vector<std::string> changes;                       // an import's first sample, stale, fresh again
-  std::set<std::string> reported;                         // "variable|writer|count" of wrong-size writers already named
+  std::vector<std::string> changes;  // an import's first sample, stale, fresh again
+  std::set<std::string> reported;    // "variable|writer|count" of wrong-size writers already named
   std::vector<std::unique_ptr<ListenerArg>> listener_args;  // what each import's listener is given
-  std::optional<IllegalConfigurationHold> stale_hold;     // the taker's thread only
-  std::optional<IllegalConfigurationHold> conflict_hold;  // the taker's thread only
+  std::optional<IllegalConfigurationHold> stale_hold;       // the taker's thread only
+  std::optional<IllegalConfigurationHold> conflict_hold;    // the taker's thread only
 
   explicit Impl(GlobalTable t) : table(std::move(t)) {}
 
@@ -146,7 +151,10 @@ struct RemotePorts::Impl {
   Result<void> add_import(const ImportSpec& import, dds_entity_t subscriber, dds_entity_t topic);
   void check_echo(ExportPort& port);
   void check_discovered(ImportPort& port);
-  void refuse_shape(const ImportPort& port, const std::string& who, std::uint32_t length);
+  void refuse_shape(ImportPort& port, const std::string& who, std::uint32_t length);
+  void check_publications();
+  void check_publication(const dds_builtintopic_endpoint_t& writer);
+  void refuse(ImportPort& port, const std::string& key, std::string message);
   void judge_staleness();
   void report(const std::string& key, std::string message);
 };
@@ -207,7 +215,8 @@ Result<void> RemotePorts::Impl::listen_to_imports() {
     });
     const dds_return_t rc = dds_set_listener(imports[i].reader, listener);
     dds_delete_listener(listener);  // the reader keeps its own copy
-    if (rc < 0) return make_error(Errc::kInvalidInput, dds_error(fmt::format("import {}", imports[i].spec.variable), rc));
+    if (rc < 0)
+      return make_error(Errc::kInvalidInput, dds_error(fmt::format("import {}", imports[i].spec.variable), rc));
     take(imports[i]);  // what came before the listener did
   }
   return {};
@@ -236,8 +245,8 @@ void RemotePorts::Impl::take_sample(ImportPort& port, const Msg& msg, const dds_
   port.status.writer_time_ns = stamp ? stamp->time_ns : info.source_timestamp;
 }
 
-void RemotePorts::Impl::refuse_shape(const ImportPort& port, const std::string& who, std::uint32_t length) {
-  report(fmt::format("{}|{}|{}", port.spec.variable, who, length),
+void RemotePorts::Impl::refuse_shape(ImportPort& port, const std::string& who, std::uint32_t length) {
+  refuse(port, fmt::format("{}|{}|{}", port.spec.variable, who, length),
          fmt::format("import {}: subsystem {} reads f64[{}] but {} publishes f64[{}] on rt/{}; its samples are refused",
                      port.spec.variable, spec.name, port.spec.count, who, length, port.spec.variable));
 }
@@ -265,6 +274,83 @@ void RemotePorts::Impl::check_discovered(ImportPort& port) {
     }
     dds_builtintopic_free_endpoint(endpoint);
   }
+}
+
+// "std_msgs::msg::dds_::String_" as ROS 2 names it: "std_msgs/msg/String".
+std::string ros_type_name(std::string_view dds_name) {
+  std::string out;
+  for (std::size_t i = 0; i < dds_name.size();) {
+    if (dds_name.substr(i).starts_with("::dds_::")) {
+      out += '/';
+      i += 8;
+    } else if (dds_name.substr(i).starts_with("::")) {
+      out += '/';
+      i += 2;
+    } else {
+      out += dds_name[i++];
+    }
+  }
+  if (out.ends_with('_')) out.pop_back();
+  return out;
+}
+
+// Whether a writer with QoS `qos` publishes in `partition` ("": DDS's default one).
+bool in_partition(const dds_qos_t* qos, const std::string& partition) {
+  std::uint32_t n = 0;
+  char** names = nullptr;
+  if (qos == nullptr || !dds_qget_partition(qos, &n, &names) || n == 0) {
+    if (names != nullptr) dds_free(static_cast<void*>(names));
+    return partition.empty();
+  }
+  bool found = false;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    found = found || partition == names[i];
+    dds_free(names[i]);
+  }
+  dds_free(static_cast<void*>(names));
+  return found;
+}
+
+// Every writer discovered, as it is: one on an import's topic of another type is named.
+void RemotePorts::Impl::check_publications() {
+  constexpr std::size_t kBatch = 16;
+  std::array<void*, kBatch> samples{};
+  std::array<dds_sample_info_t, kBatch> info{};
+  while (true) {
+    samples.fill(nullptr);
+    const dds_return_t n = dds_take(publications, samples.data(), info.data(), kBatch, kBatch);
+    if (n <= 0) return;
+    for (dds_return_t i = 0; i < n; ++i)
+      if (info[static_cast<std::size_t>(i)].valid_data)
+        check_publication(*static_cast<const dds_builtintopic_endpoint_t*>(samples[static_cast<std::size_t>(i)]));
+    dds_return_loan(publications, samples.data(), n);
+  }
+}
+
+// Equation 2's type across machines. DDS matches a reader only with writers of its type name, so a
+// writer of another type on an import's topic is never heard from: without this its variable
+// would simply stay stale, with nothing to say why.
+void RemotePorts::Impl::check_publication(const dds_builtintopic_endpoint_t& writer) {
+  const std::string_view topic = writer.topic_name != nullptr ? writer.topic_name : "";
+  const std::string_view type = writer.type_name != nullptr ? writer.type_name : "";
+  if (!topic.starts_with("rt/") || type == std_msgs_msg_dds__Float64MultiArray__desc.m_typename) return;
+  const std::string_view variable = topic.substr(3);
+  auto port =
+      std::find_if(imports.begin(), imports.end(), [&](const ImportPort& p) { return p.spec.variable == variable; });
+  if (port == imports.end() || !in_partition(writer.qos, spec.dds.partition)) return;
+  std::string who = "a writer without a Chimera stamp (a ROS 2 node?)";
+  void* data = nullptr;
+  std::size_t size = 0;
+  if (writer.qos != nullptr && dds_qget_userdata(writer.qos, &data, &size) && data != nullptr) {
+    if (const auto shape = dds_detail::parse_shape_userdata(std::string_view(static_cast<const char*>(data), size)))
+      who = fmt::format("subsystem {}", shape->writer);
+    dds_free(data);
+  }
+  const auto& guid = writer.key.v;
+  refuse(*port, fmt::format("type|{}|{}|{:02x}", variable, type, fmt::join(guid, "")),
+         fmt::format("import {}: subsystem {} reads {} but {} publishes {} on rt/{}; DDS delivers none of its samples",
+                     variable, spec.name, ros_type_name(std_msgs_msg_dds__Float64MultiArray__desc.m_typename), who,
+                     ros_type_name(type), variable));
 }
 
 // Eq. (1) across machines: any sample on an export's topic that is not ours comes from a second
@@ -305,8 +391,9 @@ void RemotePorts::Impl::judge_staleness() {
       port.said_stale = port.status.stale;
       changes.push_back(port.status.stale
                             ? fmt::format("import {}: stale, {}{}", port.spec.variable,
-                                          never ? std::string("no sample yet")
-                                                : fmt::format("no sample for {} (max_age)", format_duration(now - last)),
+                                          never
+                                              ? std::string("no sample yet")
+                                              : fmt::format("no sample for {} (max_age)", format_duration(now - last)),
                                           options.hold_when_stale ? ": the illegal-configuration flag is raised" : "")
                             : fmt::format("import {}: fresh again, from {}", port.spec.variable,
                                           port.status.writer.empty() ? std::string("a writer without a Chimera stamp")
@@ -322,8 +409,9 @@ void RemotePorts::Impl::take_loop() {
   // Wake at least this often to judge staleness; a tenth of the tightest max_age bounds how late.
   std::int64_t tick = options.poll_ns * 10;
   for (const auto& port : imports) tick = std::min(tick, std::max<std::int64_t>(port.spec.max_age_ns / 10, 100'000));
-  std::vector<dds_attach_t> triggered(imports.size() + 1 + exports.size() + imports.size());
   const std::size_t first_discovery = imports.size() + 1 + exports.size();
+  const std::size_t publications_id = first_discovery + imports.size();
+  std::vector<dds_attach_t> triggered(publications_id + 1);
   while (!stopping.load(std::memory_order_relaxed)) {  // relaxed: the flag carries no data
     const dds_return_t n =
         dds_waitset_wait(waitset, triggered.data(), triggered.size(), static_cast<dds_duration_t>(tick));
@@ -332,6 +420,7 @@ void RemotePorts::Impl::take_loop() {
       if (which > imports.size() && which < first_discovery) check_echo(exports[which - imports.size() - 1]);
       if (which >= first_discovery && which - first_discovery < imports.size())
         check_discovered(imports[which - first_discovery]);
+      if (which == publications_id) check_publications();
     }
     judge_staleness();
   }
@@ -344,10 +433,16 @@ void RemotePorts::Impl::report(const std::string& key, std::string message) {
   if (reported.insert(key).second) errors.push_back(std::move(message));
 }
 
+void RemotePorts::Impl::refuse(ImportPort& port, const std::string& key, std::string message) {
+  std::lock_guard guard(status_mutex);
+  port.status.refusal = message;
+  if (reported.insert(key).second) errors.push_back(std::move(message));
+}
+
 RemotePorts::RemotePorts(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 
 RemotePorts::~RemotePorts() {
-  impl_->stopping.store(true, std::memory_order_relaxed);  // relaxed: the joins below order the rest
+  impl_->stopping.store(true, std::memory_order_relaxed);             // relaxed: the joins below order the rest
   if (impl_->stop_fd >= 0) (void)::eventfd_write(impl_->stop_fd, 1);  // stays readable: the publisher cannot miss it
   if (impl_->wake > 0) dds_set_guardcondition(impl_->wake, true);
   if (impl_->publisher.joinable()) impl_->publisher.join();
@@ -382,6 +477,7 @@ Result<void> RemotePorts::Impl::add_import(const ImportSpec& import, dds_entity_
   ImportPort& port = imports.emplace_back();  // in place: a deque never moves it, and a listener holds it
   port.spec = import;
   port.status.variable = import.variable;
+  port.status.max_age_ns = import.max_age_ns;
   if (auto ok = check_shape(table, import.variable, import.count, "import", port.index); !ok) return ok;
   Qos qos;
   dds_qset_history(qos.q, DDS_HISTORY_KEEP_LAST, 1);
@@ -391,14 +487,14 @@ Result<void> RemotePorts::Impl::add_import(const ImportSpec& import, dds_entity_
   dds_qset_durability(qos.q, import.durability == DdsDurability::kTransientLocal ? DDS_DURABILITY_TRANSIENT_LOCAL
                                                                                  : DDS_DURABILITY_VOLATILE);
   port.reader = topic < 0 ? topic : dds_create_reader(subscriber, topic, qos.q, nullptr);
-  if (port.reader < 0) return make_error(Errc::kInvalidInput, dds_error(fmt::format("import {}", import.variable), port.reader));
+  if (port.reader < 0)
+    return make_error(Errc::kInvalidInput, dds_error(fmt::format("import {}", import.variable), port.reader));
   // The reader itself, woken only when a writer is matched or lost: its shape is checked then.
   // Its samples are taken by a listener (listen_to_imports), not through the waitset.
   const dds_return_t mask = dds_set_status_mask(port.reader, DDS_SUBSCRIPTION_MATCHED_STATUS);
-  if (mask < 0 ||
-      dds_waitset_attach(waitset, port.reader,
-                         static_cast<dds_attach_t>(spec.imports.size() + 1 + spec.exports.size() + imports.size() -
-                                                   1)) < 0)
+  if (mask < 0 || dds_waitset_attach(waitset, port.reader,
+                                     static_cast<dds_attach_t>(spec.imports.size() + 1 + spec.exports.size() +
+                                                               imports.size() - 1)) < 0)
     return make_error(Errc::kInvalidInput, dds_error(fmt::format("import {}: discovery", import.variable), mask));
   return {};
 }
@@ -421,9 +517,8 @@ Result<std::unique_ptr<RemotePorts>> RemotePorts::create(const SubsystemSpec& sp
   const dds_entity_t subscriber = dds_create_subscriber(m.participant.id, group.q, nullptr);
   if (publisher < 0 || subscriber < 0)
     return make_error(Errc::kInvalidInput, dds_error("publisher and subscriber", std::min(publisher, subscriber)));
-  // Attached to the waitset as: (i unused: import i's data goes to a listener), the wake-up -> imports.size(), export k's
-  // echo -> imports.size() + 1 + k, import i's discovered writers -> imports.size() + 1 +
-  // exports.size() + i.
+  // Attached to the waitset as: (i unused: import i's data goes to a listener), the wake-up -> imports.size(), export
+  // k's echo -> imports.size() + 1 + k, import i's discovered writers -> imports.size() + 1 + exports.size() + i.
   m.waitset = dds_create_waitset(m.participant.id);
   m.wake = dds_create_guardcondition(m.participant.id);
   if (m.waitset < 0 || m.wake < 0 ||
@@ -464,6 +559,15 @@ Result<std::unique_ptr<RemotePorts>> RemotePorts::create(const SubsystemSpec& sp
   }
   for (const auto& i : spec.imports)
     if (auto added = m.add_import(i, subscriber, topic(i.variable)); !added) return added.error();
+  if (!m.imports.empty()) {
+    m.publications = dds_create_reader(m.participant.id, DDS_BUILTIN_TOPIC_DCPSPUBLICATION, nullptr, nullptr);
+    const dds_entity_t discovered =
+        m.publications < 0 ? m.publications : dds_create_readcondition(m.publications, DDS_ANY_STATE);
+    if (discovered < 0 ||
+        dds_waitset_attach(m.waitset, discovered,
+                           static_cast<dds_attach_t>(2 * spec.imports.size() + 1 + spec.exports.size())) < 0)
+      return make_error(Errc::kInvalidInput, dds_error("the writers' discovery", discovered));
+  }
   // Never received is stale: judged now, before any thread, so the flag is up (with
   // hold_when_stale) before the caller lets a task read an import that has no value yet.
   m.judge_staleness();
@@ -481,10 +585,15 @@ Result<std::unique_ptr<RemotePorts>> RemotePorts::create(const SubsystemSpec& sp
 }
 
 std::vector<ImportStatus> RemotePorts::imports() const {
+  const std::int64_t now = monotonic_ns();
   std::lock_guard guard(impl_->status_mutex);
   std::vector<ImportStatus> out;
   out.reserve(impl_->imports.size());
-  for (const auto& port : impl_->imports) out.push_back(port.status);
+  for (const auto& port : impl_->imports) {
+    out.push_back(port.status);
+    const std::int64_t last = port.last_update_ns.load(std::memory_order_relaxed);  // relaxed: as declared
+    out.back().age_ns = last == kNeverUpdated ? -1 : std::max<std::int64_t>(now - last, 0);
+  }
   return out;
 }
 

@@ -66,13 +66,24 @@ json status_json(const Subsystem& subsystem) {
   for (const auto& t : subsystem.snapshot()) tasks.push_back(task_json(t));
   json configurations = json::array();
   for (auto& name : subsystem.configurations()) configurations.push_back(std::move(name));
+  json imports = json::array();
+  for (const auto& i : subsystem.remote_imports())
+    imports.push_back(json{{"variable", i.variable},
+                           {"stale", i.stale},
+                           {"writer", i.writer},
+                           {"samples", i.samples},
+                           {"refused", i.refused},
+                           {"age_ns", i.age_ns},
+                           {"max_age_ns", i.max_age_ns},
+                           {"refusal", i.refusal}});
   return json{{"subsystem", subsystem.spec().name},
               {"clock", subsystem.clock() == ClockKind::kVirtual ? "virtual" : "real"},
               {"now_ns", subsystem.now_ns()},
               {"configuration", subsystem.configuration()},
               {"configurations", std::move(configurations)},
               {"illegal_configuration", subsystem.illegal_configuration()},
-              {"tasks", std::move(tasks)}};
+              {"tasks", std::move(tasks)},
+              {"imports", std::move(imports)}};
 }
 
 // The numbers of a `get` or `set` reply, "VAR = [1, 2.5]": read back from the very text the shell

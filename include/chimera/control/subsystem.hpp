@@ -16,6 +16,7 @@
 
 #include "chimera/config/subsystem.hpp"
 #include "chimera/config/verify.hpp"
+#include "chimera/control/remote_imports.hpp"
 #include "chimera/core/result.hpp"
 #include "chimera/exec/clock.hpp"
 #include "chimera/exec/event.hpp"
@@ -135,6 +136,13 @@ class Subsystem {
   /// been made: 1 after create, one more for each task the live assembly added. Whoever attached
   /// to the table by its name (the DDS bridge) attaches again when it changes. Any thread.
   [[nodiscard]] std::uint64_t runtimes_built() const;
+  /// From now on `status` (the shell's and the network API's) shows the imports that `report`
+  /// tells of: how the DDS bridge, which lives above this part, makes them visible. An empty
+  /// function: none. Call it from the thread that drives the commands, while no command runs
+  /// (the report is called under the command gate). Not real-time safe.
+  void report_remote_imports(RemoteImportsReport report);
+  /// What the report tells now, in file order; none without one. Not real-time safe.
+  [[nodiscard]] std::vector<RemoteImport> remote_imports() const;
 
   // The live assembly (docs/control-api.md, "Live assembly"), what ros2_control users do with
   // load, configure and switch. Each refuses, changing nothing, what it cannot carry out, with one

@@ -36,6 +36,9 @@ struct ImportStatus {
   std::uint64_t writer_sequence = 0;  // its sequence number (0 without a stamp)
   std::int64_t writer_time_ns = 0;    // its wall-clock time when it wrote: not comparable to ours
   bool stale = true;                  // not written within max_age (nor ever, at first)
+  std::int64_t age_ns = -1;           // since the last sample was written (our clock); -1: none yet
+  std::int64_t max_age_ns = 0;        // its file's max_age
+  std::string refusal;                // the last remote writer refused for it (size, type), "" if none
 };
 
 class RemotePorts {
@@ -56,7 +59,9 @@ class RemotePorts {
   [[nodiscard]] std::vector<ImportStatus> imports() const;
   /// Problems seen since the last call, one line each, oldest first: a remote writer of the wrong
   /// size (named, with both ends' shapes, once per writer and variable: at its discovery when it
-  /// is a Chimera subsystem, else at its first sample), a second exporter of a variable (eq. 1).
+  /// is a Chimera subsystem, else at its first sample), a remote writer of another type on an
+  /// import's topic (at its discovery: DDS never delivers its samples), a second exporter of a
+  /// variable (eq. 1).
   /// Not real-time safe.
   [[nodiscard]] std::vector<std::string> take_errors();
   /// What changed since the last call, one line each, oldest first: an import's first sample, an

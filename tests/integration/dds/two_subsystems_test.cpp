@@ -17,6 +17,7 @@
 #include <cstdlib>
 #include <functional>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -128,6 +129,19 @@ struct Side {
   std::string get(const std::string& variable) const { return ask("# " + variable, variable); }
   std::string theta_m() const { return ask("# theta_m"); }
   bool flag_raised() const { return ask("status").find(kFlag) != std::string::npos; }
+  // The words of `status`'s row for the import `variable` (its second table: import, state, from,
+  // samples, refused, age, max_age; a duration is two words, "1.20 ms"); none if it has no such row.
+  std::vector<std::string> import_row(const std::string& variable) const {
+    const std::string status = ask("status");
+    const auto table = status.find("\nimport ");
+    if (table == std::string::npos) return {};
+    const auto row = status.find("\n" + variable + " ", table + 1);
+    if (row == std::string::npos) return {};
+    std::istringstream line(status.substr(row + 1, status.find('\n', row + 1) - row - 1));
+    std::vector<std::string> words;
+    for (std::string w; line >> w;) words.push_back(w);
+    return words;
+  }
 
   // The arm holds: two readings of theta_m half a second apart differ by under a milliradian
   // (held in position mode, the simulated servo settles where the flag found the arm).
@@ -225,6 +239,13 @@ void robot_holds_while_vision_is_away(const std::vector<std::string>& vision_lau
   })) << robot.err();
   EXPECT_TRUE(robot.flag_raised());
   EXPECT_EQ(robot.theta_m(), kInitial);
+  // `status` says so beside the tasks: stale, from nobody yet, no sample, no age.
+  const std::vector<std::string> alone = robot.import_row("x_d");
+  ASSERT_GE(alone.size(), 7U) << robot.ask("status");
+  EXPECT_EQ(alone[1], "STALE");
+  EXPECT_EQ(alone[2], "-");
+  EXPECT_EQ(alone[3], "0");
+  EXPECT_EQ(alone[5], "-");
 
   // The vision side up: x_d arrives, the flag comes down, the arm follows the target.
   auto vision = std::make_unique<Side>(names.vision, vision_file(names), vision_launcher);
@@ -239,6 +260,13 @@ void robot_holds_while_vision_is_away(const std::vector<std::string>& vision_lau
   })) << vision->err();
   EXPECT_TRUE(eventually([&] { return !robot.flag_raised(); })) << robot.ask("status");
   EXPECT_TRUE(eventually([&] { return robot.theta_m() != kInitial; }));
+  const std::vector<std::string> fed = robot.import_row("x_d");
+  ASSERT_GE(fed.size(), 7U) << robot.ask("status");
+  EXPECT_EQ(fed[1], "fresh");
+  EXPECT_EQ(fed[2], names.vision);
+  EXPECT_NE(fed[3], "0");
+  EXPECT_EQ(fed[4], "0");
+  EXPECT_NE(fed[5], "-");
 
   if (network != nullptr) {
     // The cable pulled: the import goes stale and the arm is held; plugged back in, it moves again.
@@ -263,6 +291,10 @@ void robot_holds_while_vision_is_away(const std::vector<std::string>& vision_lau
   EXPECT_TRUE(robot.flag_raised());
   EXPECT_TRUE(robot.holds());
   EXPECT_TRUE(robot.process->running());
+  const std::vector<std::string> away = robot.import_row("x_d");
+  ASSERT_GE(away.size(), 7U) << robot.ask("status");
+  EXPECT_EQ(away[1], "STALE");
+  EXPECT_EQ(away[2], names.vision);  // who fed it last
 
   // Brought back (its stale shared memory is no obstacle): fresh again, the flag down, the arm moving.
   vision = std::make_unique<Side>(names.vision, vision_file(names), vision_launcher);
@@ -299,8 +331,9 @@ TEST(TwoSubsystems, TheBridgeFollowsTheTableThatAnAddMadeAnew) {
   // The vision task gone: the robot side's import goes stale; back after the add, fresh again.
   const std::size_t fresh_before = count(robot.err(), fresh);
   vision.process->send("kill vision\n");
-  ASSERT_TRUE(eventually([&] { return robot.err().find("dds: import x_d: stale, no sample for ") != std::string::npos; }))
-      << robot.err();
+  ASSERT_TRUE(eventually([&] {
+    return robot.err().find("dds: import x_d: stale, no sample for ") != std::string::npos;
+  })) << robot.err();
   vision.process->send("add {name: spare, module: cpu_load, period: 100ms, criticality: soft}\n");
   EXPECT_TRUE(eventually([&] { return vision.err().find("the bridge follows it") != std::string::npos; }, 10))
       << vision.err() << vision.process->out();
@@ -347,8 +380,9 @@ TEST(TwoSubsystems, AFileOpenedWithImportsIsBridged) {
   EXPECT_TRUE(eventually([&] {
     return robot.err().find("dds: the subsystem has no exports or imports now: the bridge stops") != std::string::npos;
   })) << robot.err();
-  EXPECT_TRUE(eventually([&] { return vision.err().find("dds: import x_m: stale, no sample for ") != std::string::npos; }))
-      << vision.err();
+  EXPECT_TRUE(eventually([&] {
+    return vision.err().find("dds: import x_m: stale, no sample for ") != std::string::npos;
+  })) << vision.err();
 
   vision.process->send("quit\n");
   EXPECT_EQ(vision.process->wait_exit(), 0) << vision.err();

@@ -30,6 +30,13 @@ TaskSpec task(std::string name, std::string module, std::int64_t period_ns,
   return t;
 }
 
+std::vector<std::string> words(const std::string& line) {
+  std::istringstream in(line);
+  std::vector<std::string> out;
+  for (std::string w; in >> w;) out.push_back(w);
+  return out;
+}
+
 // counter -> doubler, a faulty task beside them, and a spare counter outside the start
 // configuration (so it begins NOT-CREATED).
 SubsystemSpec make_spec() {
@@ -84,10 +91,7 @@ class ControlTest : public ::testing::Test {
     std::istringstream lines(r.text);
     std::string line;
     while (std::getline(lines, line)) {
-      std::istringstream words(line);
-      std::vector<std::string> row;
-      std::string w;
-      while (words >> w) row.push_back(w);
+      std::vector<std::string> row = words(line);
       if (!row.empty() && row.front() == name) return row;
     }
     ADD_FAILURE() << "no row for " << name << " in\n" << r.text;
@@ -112,6 +116,37 @@ TEST_F(ControlTest, StatusIsATableOfEveryTask) {
             (std::vector<std::string>{"counter", "test_counter", "ON", cpu["counter"], "1", "ms", "10", "0"}));
   EXPECT_EQ(status_row("spare"),
             (std::vector<std::string>{"spare", "test_counter", "NOT-CREATED", cpu["spare"], "2", "ms", "0", "0"}));
+}
+
+// The imports other subsystems feed (the DDS bridge's report) are a second table of `status`: one
+// row each, fresh or STALE, whom from, and the last remote refused. Without a report there is none.
+TEST_F(ControlTest, StatusShowsTheImportsTheBridgeReports) {
+  EXPECT_EQ(run("status").text.find("import"), std::string::npos);
+  RemoteImport fed{"x_d", "vision", 120, 0, 2 * kMs, 50 * kMs, false, ""};
+  RemoteImport refused{"x_m", "", 0, 3, -1, 50 * kMs, true, "import x_m: a remote of another size"};
+  int asked = 0;
+  subsystem_->report_remote_imports([&] {
+    ++asked;
+    return std::vector<RemoteImport>{fed, refused};
+  });
+  const Reply r = run("status");
+  ASSERT_TRUE(r.ok) << r.text;
+  EXPECT_EQ(asked, 1);
+  const auto table = r.text.find("\nimport ");
+  ASSERT_NE(table, std::string::npos) << r.text;
+  std::istringstream lines(r.text.substr(table + 1));
+  std::string header;
+  std::getline(lines, header);
+  for (const char* column : {"state", "from", "samples", "refused", "age", "max_age", "refused from"})
+    EXPECT_NE(header.find(column), std::string::npos) << column;
+  std::string row;
+  std::getline(lines, row);
+  EXPECT_EQ(words(row), (std::vector<std::string>{"x_d", "fresh", "vision", "120", "0", "2.00", "ms", "50.00", "ms"}));
+  std::getline(lines, row);
+  EXPECT_EQ(words(row), (std::vector<std::string>{"x_m", "STALE", "-", "0", "3", "-", "50.00", "ms", "import",
+                                                  "x_m:", "a", "remote", "of", "another", "size"}));
+  subsystem_->report_remote_imports({});
+  EXPECT_EQ(run("status").text.find("import"), std::string::npos);
 }
 
 TEST_F(ControlTest, SignalsAreReflectedInStatus) {

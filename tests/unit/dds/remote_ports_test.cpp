@@ -20,6 +20,7 @@
 
 #include "chimera/svt/global_table.hpp"
 #include "float64_multi_array.h"
+#include "ros_string.h"
 
 namespace chimera {
 namespace {
@@ -101,6 +102,9 @@ TEST(RemotePorts, AnExportLandsInTheImportersTableWithItsStamp) {
   EXPECT_EQ(status.writer_sequence, 1U);
   EXPECT_GT(status.writer_time_ns, 0);
   EXPECT_EQ(status.refused, 0U);
+  EXPECT_GE(status.age_ns, 0);
+  EXPECT_EQ(status.max_age_ns, 50'000'000);
+  EXPECT_EQ(status.refusal, "");
 
   // A new value, a new sample: the latest value, never a queue.
   const std::array<double, 6> next{1, 2, 3, 4, 5, 6};
@@ -181,6 +185,32 @@ struct RawWriter {
   }
 };
 
+// A ROS 2 node publishing std_msgs/msg/String on an import's topic: DDS never matches it with the
+// importer's reader, whose type is another.
+struct TextWriter {
+  dds_entity_t participant = dds_create_participant(DDS_DOMAIN_DEFAULT, nullptr, nullptr);
+  dds_entity_t writer = 0;
+
+  TextWriter(const std::string& partition, const std::string& topic_name) {
+    dds_qos_t* qos = dds_create_qos();
+    dds_qset_partition1(qos, partition.c_str());
+    const dds_entity_t publisher = dds_create_publisher(participant, qos, nullptr);
+    dds_delete_qos(qos);
+    const dds_entity_t topic =
+        dds_create_topic(participant, &std_msgs_msg_dds__String__desc, topic_name.c_str(), nullptr, nullptr);
+    writer = dds_create_writer(publisher, topic, nullptr, nullptr);
+    EXPECT_GT(writer, 0);
+  }
+  ~TextWriter() { dds_delete(participant); }
+  TextWriter(const TextWriter&) = delete;
+  TextWriter& operator=(const TextWriter&) = delete;
+
+  void write(std::string text) const {
+    std_msgs_msg_dds__String_ msg{text.data()};
+    EXPECT_EQ(dds_write(writer, &msg), DDS_RETCODE_OK);
+  }
+};
+
 std::vector<std::string> collect_errors(RemotePorts& ports, std::vector<std::string>& errors) {
   auto more = ports.take_errors();
   errors.insert(errors.end(), more.begin(), more.end());
@@ -188,6 +218,41 @@ std::vector<std::string> collect_errors(RemotePorts& ports, std::vector<std::str
 }
 
 // A writer that says nothing of its shape (a ROS 2 node) is checked sample by sample.
+// Equation 2's type across machines: a writer of another type on an import's topic is named when it
+// is discovered (DDS would deliver none of its samples, and the import would only stay stale);
+// `status` keeps the refusal beside the import. One of the wire format's type in another
+// partition, or on another topic, is no concern of this import.
+TEST(RemotePorts, AWriterOfAnotherTypeOnAnImportsTopicIsNamedAtDiscovery) {
+  Side robot = importer(6);
+  auto in = bridge(robot);
+  ASSERT_TRUE(in);
+  EXPECT_EQ(in->imports().front().age_ns, -1);  // no sample yet
+  const TextWriter elsewhere(unique("other_part"), "rt/x_d");
+  const TextWriter other_topic(robot.spec.dds.partition, "rt/y_d");
+  const TextWriter ros_node(robot.spec.dds.partition, "rt/x_d");
+  std::vector<std::string> errors;
+  ASSERT_TRUE(eventually([&] { return !collect_errors(*in, errors).empty(); }));
+  ros_node.write("hello");
+  other_topic.write("hello");
+  elsewhere.write("hello");
+  const std::string named = "import x_d: subsystem " + robot.spec.name +
+                            " reads std_msgs/msg/Float64MultiArray but a writer without a Chimera stamp (a ROS 2 "
+                            "node?) publishes std_msgs/msg/String on rt/x_d; DDS delivers none of its samples";
+  ASSERT_EQ(errors.size(), 1U) << errors.back();
+  EXPECT_EQ(errors[0], named);
+  // The other two were discovered as well by now (one participant's discovery is not slower than
+  // another's on one machine); give them the time a third writer takes to be heard.
+  const TextWriter third(robot.spec.dds.partition, "rt/x_d");
+  ASSERT_TRUE(eventually([&] { return collect_errors(*in, errors).size() >= 2; }));
+  EXPECT_EQ(errors.size(), 2U);
+  EXPECT_EQ(errors[1], named);  // the third, a writer of its own
+  const ImportStatus status = in->imports().front();
+  EXPECT_EQ(status.refusal, named);
+  EXPECT_EQ(status.samples, 0U);
+  EXPECT_TRUE(status.stale);
+  EXPECT_EQ(robot.table.version(robot.index), 0U);
+}
+
 TEST(RemotePorts, AWriterWithoutAStampOfTheWrongSizeIsRefusedSampleBySample) {
   Side robot = importer(6);
   auto in = bridge(robot);
