@@ -60,6 +60,11 @@ KEYS = [
     Key("process_fig4_latency_p50_ratio", "x",
         "Figure 4 at 1 kHz, worst task's release latency p50: PID in its own process / all in one"),
     Key("process_fig4_latency_p99_ratio", "x", "the same, p99"),
+    Key("process_pid_cycle_ns", "ns",
+        "the same, PID in its own process: its mean cycle (the module and the framework's transfers and bookkeeping)"),
+    Key("process_pid_cycle_extra_ns", "ns", "the same, over the PID's mean cycle all in one"),
+    Key("process_switch_lost_cycles", "cycles",
+        "lost cycles of the PID over switches at 1 kHz between a generator in the main process and one in a module process"),
     Key("process_death_to_error_ns_p50", "ns", "a module process killed: to its task in ERROR and the flag up, p50"),
     Key("process_death_to_error_ns_max", "ns", "the same, worst"),
     Key("process_clear_to_on_ns_p50", "ns", "clear (the process started anew) then on: to the task ON, p50"),
@@ -178,6 +183,16 @@ GOALS = [
          lambda r: (r["process_fig4_latency_p50_ratio"] <= 1.1 and r["process_fig4_latency_p99_ratio"] <= 1.1)
          if _have(r, "process_fig4_latency_p50_ratio", "process_fig4_latency_p99_ratio") else None,
          lambda r: (f"p50 {r['process_fig4_latency_p50_ratio']:.2f}x, p99 {r['process_fig4_latency_p99_ratio']:.2f}x")),
+    Goal("a task in a module process: framework cost per cycle <= 1 µs (the PID's whole mean cycle, module included)",
+         ["process_pid_cycle_ns"],
+         lambda r: r["process_pid_cycle_ns"] <= 1000 if _have(r, "process_pid_cycle_ns") else None,
+         lambda r: _fmt(r["process_pid_cycle_ns"]) + (
+             f" ({_fmt(r['process_pid_cycle_extra_ns'])} more than all in one)"
+             if _have(r, "process_pid_cycle_extra_ns") else "")),
+    Goal("0 lost cycles over switches across processes at 1 kHz",
+         ["process_switch_lost_cycles"],
+         lambda r: r["process_switch_lost_cycles"] == 0 if _have(r, "process_switch_lost_cycles") else None,
+         lambda r: f"{r['process_switch_lost_cycles']:g} lost"),
     Goal("a module process's death seen as ERROR within one period of the fastest task (1 ms)",
          ["process_death_to_error_ns_max"],
          lambda r: r["process_death_to_error_ns_max"] <= 1_000_000 if _have(r, "process_death_to_error_ns_max")

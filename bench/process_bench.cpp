@@ -3,7 +3,12 @@
 //     the same file with the PID in a module process of its own; runs alternate. Per run: every
 //     task's release latency p50 and p99 (the worst task's is the run's), each task's mean cycle
 //     (the framework's transfers and bookkeeping plus the module), cycles run and misses.
-//  2. A module process's death seen as ERROR: the PID's process killed by SIGKILL at a known
+//  2. Switches across processes: Figure 4's trajectory generator in the chimera process or in a
+//     module process ('planner'), the two configurations switched back and forth at 1 kHz while
+//     the PID consumes its output. Lost cycles as switch_bench counts them: the PID's releases
+//     that did not run, plus the releases that no generator (or two) ran, the PID's cycles against
+//     the generators' together.
+//  3. A module process's death seen as ERROR: the PID's process killed by SIGKILL at a known
 //     instant, then the time until the illegal-configuration flag is up with the task in ERROR
 //     (goal: within one period of the fastest task, 1 ms); then the time from `clear` to ON again
 //     (clear starts the process anew, on turns the task on).
@@ -11,7 +16,10 @@
 //   process_bench [--quick] [--out FILE] [--worker PATH]
 //
 // Keys: process_fig4_latency_p50_ratio, process_fig4_latency_p99_ratio (PID in its own process
-// over all in one), process_death_to_error_ns_p50/_max, process_clear_to_on_ns_p50/_max.
+// over all in one), process_pid_cycle_ns (the PID's mean cycle in its own process: the module and
+// the framework's transfers and bookkeeping, the cycle-cost figure of a task in another process)
+// and process_pid_cycle_extra_ns (over the same all in one), process_switch_lost_cycles,
+// process_death_to_error_ns_p50/_max, process_clear_to_on_ns_p50/_max.
 
 #include <signal.h>
 #include <time.h>
@@ -68,6 +76,7 @@ const TaskSnapshot* find(const std::vector<TaskSnapshot>& all, const std::string
 struct LoopRun {
   std::int64_t latency_p50_ns = 0;  // the worst task's
   std::int64_t latency_p99_ns = 0;
+  std::int64_t pid_cycle_ns = 0;  // the PID's mean cycle
   std::uint64_t cycles = 0;
   std::uint64_t missed = 0;
   nlohmann::json tasks;
@@ -85,6 +94,7 @@ Result<LoopRun> run_loop(bool pid_apart, const std::string& worker, std::int64_t
     r.latency_p99_ns = std::max(r.latency_p99_ns, t.stats.latency_p99_ns);
     r.cycles += t.stats.cycles;
     r.missed += t.stats.missed;
+    if (t.name == "pid") r.pid_cycle_ns = t.stats.exec_mean_ns;
     r.tasks[t.name] = {{"cycles", t.stats.cycles},
                        {"missed", t.stats.missed},
                        {"latency_p50_ns", t.stats.latency_p50_ns},
@@ -94,6 +104,75 @@ Result<LoopRun> run_loop(bool pid_apart, const std::string& worker, std::int64_t
   }
   s.stop();
   return r;
+}
+
+constexpr const char* kSwitchFile =
+    "subsystem: process_bench_switch\n"
+    "scheduler: rm\n"
+    "tasks:\n"
+    "  - {name: traj_here, module: joint_traj_gen, period: 1ms, criticality: soft, late: run}\n"
+    "  - {name: traj_there, module: joint_traj_gen, period: 1ms, criticality: soft, late: run, process: planner}\n"
+    "  - {name: pid, module: pid_joint, period: 1ms, criticality: soft, late: run}\n"
+    "  - {name: robot, module: robot_torque, period: 1ms, criticality: soft, late: run}\n"
+    "configurations:\n"
+    "  here: [traj_here, pid, robot]\n"
+    "  there: [traj_there, pid, robot]\n"
+    "start: here\n";
+
+struct SwitchRun {
+  int switches = 0;
+  int failed = 0;
+  double seconds = 0;
+  double pid_cycles = 0;
+  double pid_expected = 0;
+  double not_run = 0;       // the PID's releases that did not run
+  double producer_gap = 0;  // releases that no generator, or two, ran
+  std::uint64_t pid_missed = 0;
+  std::string error;
+};
+
+SwitchRun switch_across(const std::string& worker, int switches) {
+  SwitchRun out;
+  const std::string path = fmt::format("/tmp/process_bench_switch_{}.yaml", ::getpid());
+  std::ofstream(path) << kSwitchFile;
+  auto spec = load_subsystem_file(path, Registry::global());
+  if (!spec) return {.error = spec.error().message};
+  RunOptions options;
+  options.clock = ClockKind::kReal;
+  options.worker_program = worker;
+  auto made = Subsystem::create(*spec, Registry::global(), options);
+  if (!made) return {.error = made.error().message};
+  Subsystem& s = **made;
+  if (auto started = s.start(); !started) return {.error = started.error().message};
+  // traj_there created (its process started) once, so that every measured switch is a commit.
+  if (!s.switch_to("there") || !s.switch_to("here")) return {.error = "the warm-up switches failed"};
+  s.run_for(50 * kMs);
+  auto stats_of = [&](const std::vector<TaskSnapshot>& all, const char* name) {
+    const TaskSnapshot* t = find(all, name);
+    return t != nullptr ? t->stats : TaskStatsSnapshot{};
+  };
+  const auto before = s.snapshot();
+  const std::int64_t t0 = s.now_ns();
+  for (int i = 0; i < switches; ++i)
+    if (!s.switch_to(i % 2 == 0 ? "there" : "here")) ++out.failed;
+  s.run_for(20 * kMs);  // the last switch's generator runs a few cycles
+  const std::int64_t t1 = s.now_ns();
+  const auto after = s.snapshot();
+  s.stop();
+  std::remove(path.c_str());
+  for (const auto& t : after)
+    if (t.state == TaskState::kError) return {.error = fmt::format("{} in ERROR: {}", t.name, t.last_error)};
+  out.switches = switches;
+  out.seconds = static_cast<double>(t1 - t0) * 1e-9;
+  out.pid_cycles = static_cast<double>(stats_of(after, "pid").cycles - stats_of(before, "pid").cycles);
+  out.pid_expected = static_cast<double>(t1 - t0) / 1e6;
+  out.not_run = std::max(0.0, out.pid_expected - out.pid_cycles - 1.0);  // one release of slack at either edge
+  const auto generated = [&](const std::vector<TaskSnapshot>& all) {
+    return static_cast<double>(stats_of(all, "traj_here").cycles + stats_of(all, "traj_there").cycles);
+  };
+  out.producer_gap = std::abs(out.pid_cycles - (generated(after) - generated(before)));
+  out.pid_missed = stats_of(after, "pid").missed - stats_of(before, "pid").missed;
+  return out;
 }
 
 // The module process of this process (the only child that is a chimera worker).
@@ -170,6 +249,7 @@ int main(int argc, char** argv) {
   d["run_s"] = static_cast<double>(run_ns) / 1e9;
   std::vector<std::int64_t> p50[2];
   std::vector<std::int64_t> p99[2];
+  std::vector<std::int64_t> pid_cycle[2];
   for (int r = 0; r < pairs; ++r) {
     for (const bool apart : {false, true}) {
       auto run = run_loop(apart, worker, run_ns);
@@ -182,6 +262,7 @@ int main(int argc, char** argv) {
       }
       p50[apart ? 1 : 0].push_back(run->latency_p50_ns);
       p99[apart ? 1 : 0].push_back(run->latency_p99_ns);
+      pid_cycle[apart ? 1 : 0].push_back(run->pid_cycle_ns);
       d["runs"][mode].push_back({{"latency_p50_ns", run->latency_p50_ns},
                                  {"latency_p99_ns", run->latency_p99_ns},
                                  {"cycles", run->cycles},
@@ -197,6 +278,27 @@ int main(int argc, char** argv) {
   d["latency_p99_ns_median"] = {{"all_in_one", median(p99[0])}, {"pid_in_own_process", median(p99[1])}};
   if (median(p50[0]) > 0) out.result("process_fig4_latency_p50_ratio", median(p50[1]) / median(p50[0]));
   if (median(p99[0]) > 0) out.result("process_fig4_latency_p99_ratio", median(p99[1]) / median(p99[0]));
+  d["pid_cycle_ns_median"] = {{"all_in_one", median(pid_cycle[0])}, {"pid_in_own_process", median(pid_cycle[1])}};
+  out.result("process_pid_cycle_ns", median(pid_cycle[1]));
+  out.result("process_pid_cycle_extra_ns", median(pid_cycle[1]) - median(pid_cycle[0]));
+
+  const SwitchRun sw = switch_across(worker, args.quick ? 500 : 5'000);
+  if (!sw.error.empty()) {
+    std::fprintf(stderr, "process_bench: switches: %s\n", sw.error.c_str());
+    d["error"] = "switches: " + sw.error;
+    (void)out.write(args);
+    return 1;
+  }
+  d["switch"] = {{"loop", "traj_here (main process) or traj_there (process planner), pid, robot at 1 kHz"},
+                 {"switches", sw.switches},
+                 {"switches_failed", sw.failed},
+                 {"switching_s", sw.seconds},
+                 {"pid_cycles", sw.pid_cycles},
+                 {"pid_cycles_expected", sw.pid_expected},
+                 {"pid_releases_not_run", sw.not_run},
+                 {"producer_gap", sw.producer_gap},
+                 {"pid_missed_deadlines", sw.pid_missed}};
+  out.result("process_switch_lost_cycles", sw.not_run + sw.producer_gap + sw.failed);
 
   Recovery rec = kill_and_clear(worker, kills);
   d["kills"] = kills;

@@ -317,8 +317,10 @@ PROGRAMS = [
     Program("virtual_clock", "apps/chimera/chimera", "Figure 4 on the virtual clock",
             ["virtual_clock_speedup_fig4"], run=run_virtual_clock),
     Program("policies", "policy_bench", "rm, edf and muf on the real clock: deadlines missed", []),
-    Program("processes", "process_bench", "module processes: the PID in its own process, a death to ERROR, clear to ON",
-            ["process_fig4_latency_p50_ratio", "process_fig4_latency_p99_ratio", "process_death_to_error_ns_p50",
+    Program("processes", "process_bench", "module processes: the PID in its own process, switches across processes, "
+            "a death to ERROR, clear to ON",
+            ["process_fig4_latency_p50_ratio", "process_fig4_latency_p99_ratio", "process_pid_cycle_ns",
+             "process_pid_cycle_extra_ns", "process_switch_lost_cycles", "process_death_to_error_ns_p50",
              "process_death_to_error_ns_max", "process_clear_to_on_ns_p50", "process_clear_to_on_ns_max"]),
     Program("network_api", "apps/chimera/chimera", "the control API under load: 10 clients streaming, round trips, 100 clients",
             ["api_stream_latency_p99_ratio", "api_round_trip_ns_p50", "api_round_trip_ns_p99",
