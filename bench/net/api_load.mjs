@@ -1,7 +1,10 @@
 // The network API's load for bench/run.py (issue 14, section 3): clients streaming state
 // variables over /api/stream, and commands' round trips, against a running chimera.
 //
-//   node --experimental-websocket bench/net/api_load.mjs stream URL TOKEN CLIENTS RATE_HZ SECONDS VAR,VAR,...
+//   node --experimental-websocket bench/net/api_load.mjs stream URL TOKEN CLIENTS RATE_HZ SECONDS VAR,VAR,... [BATCH_HZ]
+//
+// With BATCH_HZ the clients subscribe as Onika does (batch_hz: the samples in that many frames a
+// second); `samples` counts the samples received either way, `frames` the frames.
 //   node --experimental-websocket bench/net/api_load.mjs roundtrip URL TOKEN COUNT [keepalive]
 //
 // URL is http://127.0.0.1:PORT/. Prints one JSON object on stdout.
@@ -16,14 +19,16 @@ function percentile(sorted, p) {
   return sorted[Math.min(sorted.length - 1, Math.floor(p * (sorted.length - 1)))];
 }
 
-async function stream(clients, rateHz, seconds, variables) {
+async function stream(clients, rateHz, seconds, variables, batchHz) {
   const sockets = [];
   const counts = [];
+  const frameCounts = [];
   let accepted = 0;
   let refused = 0;
   const opened = [];
   for (let i = 0; i < clients; ++i) {
     counts.push(0);
+    frameCounts.push(0);
     const socket = new WebSocket(`${wsBase}api/stream?access_token=${encodeURIComponent(token)}`);
     sockets.push(socket);
     opened.push(
@@ -35,7 +40,7 @@ async function stream(clients, rateHz, seconds, variables) {
         socket.onopen = () => {
           clearTimeout(timer);
           accepted += 1;
-          socket.send(JSON.stringify({ variables, rate_hz: rateHz }));
+          socket.send(JSON.stringify(batchHz ? { variables, rate_hz: rateHz, batch_hz: batchHz } : { variables, rate_hz: rateHz }));
           resolve();
         };
         socket.onerror = () => {};
@@ -47,18 +52,23 @@ async function stream(clients, rateHz, seconds, variables) {
     );
     socket.onmessage = (event) => {
       const frame = JSON.parse(event.data);
-      if (frame.values) counts[i] += 1;
+      if (!frame.values) return;
+      counts[i] += frame.kind === 'samples' ? frame.count : 1;
+      frameCounts[i] += 1;
     };
   }
   await Promise.all(opened);
   refused = clients - accepted;
   const start = performance.now();
-  const before = counts.reduce((a, b) => a + b, 0);
+  const sum = (list) => list.reduce((a, b) => a + b, 0);
+  const before = sum(counts);
+  const framesBefore = sum(frameCounts);
   await new Promise((r) => setTimeout(r, seconds * 1000));
-  const frames = counts.reduce((a, b) => a + b, 0) - before;
+  const samples = sum(counts) - before;
+  const frames = sum(frameCounts) - framesBefore;
   const elapsed = (performance.now() - start) / 1000;
   for (const s of sockets) s.close();
-  return { clients, accepted, refused, variables: variables.length, rate_hz: rateHz, seconds: elapsed, frames, frames_per_client_per_s: accepted ? frames / accepted / elapsed : 0 };
+  return { clients, accepted, refused, variables: variables.length, rate_hz: rateHz, batch_hz: batchHz || 0, seconds: elapsed, samples, frames, samples_per_client_per_s: accepted ? samples / accepted / elapsed : 0, frames_per_client_per_s: accepted ? frames / accepted / elapsed : 0 };
 }
 
 // One request: on a new connection each (agent false), as `curl` sends it, or on one kept open
@@ -90,8 +100,8 @@ async function roundtrip(count, keepAlive) {
 
 let result;
 if (mode === 'stream') {
-  const [clients, rate, seconds, vars] = rest;
-  result = await stream(Number(clients), Number(rate), Number(seconds), vars.split(','));
+  const [clients, rate, seconds, vars, batch] = rest;
+  result = await stream(Number(clients), Number(rate), Number(seconds), vars.split(','), Number(batch || 0));
 } else if (mode === 'roundtrip') {
   result = await roundtrip(Number(rest[0]), rest[1] === 'keepalive');
 } else {

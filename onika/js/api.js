@@ -69,7 +69,7 @@ export const api = {
 /**
  * One WebSocket stream of /api/stream (docs/control-api.md, "Streams"): the page names what it
  * watches, {variables, rate_hz}, {timing_hz, tasks}, {events: true}, and gets frames by kind
- * ("sample", "timing", "event", "missed"). The server never queues: a page that draws slowly
+ * ("sample" or, with batch_hz, "samples"; "timing", "event", "missed"). The server never queues: a page that draws slowly
  * gets fewer samples, and no task ever waits for it. onFrame(frame) per frame; onState(text)
  * when the connection changes. With `reconnect`, a stream that closed opens again after a pause.
  */

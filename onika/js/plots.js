@@ -65,6 +65,15 @@ export class Plot {
     this.schedule();
   }
 
+  /** One "samples" frame (batch_hz): {t_ns: [..], values: {name: [one value or null per sample]}}. */
+  addSamples(frame) {
+    frame.t_ns.forEach((t_ns, k) => {
+      const values = {};
+      for (const [name, list] of Object.entries(frame.values)) values[name] = list[k];
+      this.addSample({ t_ns, values });
+    });
+  }
+
   /** A recorded log, replacing what is shown. */
   showLog(log) {
     this.reset(false);

@@ -28,8 +28,8 @@ std::string error_text(std::string_view code, std::string_view message) {
 }
 
 constexpr std::string_view kUsage =
-    R"(a subscription is {"variables": ["theta_m", ...], "rate_hz": 100, "timing_hz": 2, "tasks": [...], )"
-    R"("events": true}, each part optional, at least one asked for)";
+    R"(a subscription is {"variables": ["theta_m", ...], "rate_hz": 100, "batch_hz": 30, "timing_hz": 2, )"
+    R"("tasks": [...], "events": true}, each part optional, at least one asked for)";
 
 struct Refusal {
   std::string code;
@@ -74,7 +74,8 @@ std::variant<Subscription, Refusal> parse_subscription(std::string_view text, co
   const json doc = json::parse(text, nullptr, false);
   if (doc.is_discarded() || !doc.is_object()) return Refusal{"bad_request", std::string(kUsage)};
   for (const auto& [key, value] : doc.items())
-    if (key != "variables" && key != "rate_hz" && key != "timing_hz" && key != "tasks" && key != "events")
+    if (key != "variables" && key != "rate_hz" && key != "batch_hz" && key != "timing_hz" && key != "tasks" &&
+        key != "events")
       return Refusal{"bad_request", fmt::format("unknown key '{}': {}", key, kUsage)};
   Subscription wanted;
   const auto variables = names_of(doc, "variables");
@@ -91,6 +92,16 @@ std::variant<Subscription, Refusal> parse_subscription(std::string_view text, co
                                                 ApiStream::kMaxRateHz)};
     if (wanted.variables.empty()) return Refusal{"bad_request", "rate_hz without variables to sample"};
     wanted.sample_period_ns = std::llround(1e9 / *rate);
+  }
+  if (doc.contains("batch_hz")) {
+    const auto batch = rate_of(doc, "batch_hz");
+    if (wanted.sample_period_ns == 0) return Refusal{"bad_request", "batch_hz without variables to sample"};
+    if (!batch || !(*batch >= ApiStream::kMinRateHz && *batch <= ApiStream::kMaxRateHz))
+      return Refusal{"bad_request", fmt::format("batch_hz: from {} to {}, frames a second", ApiStream::kMinRateHz,
+                                                ApiStream::kMaxRateHz)};
+    // As often as the samples, or more: one frame per sample, as without it.
+    const std::int64_t period = std::llround(1e9 / *batch);
+    if (period > wanted.sample_period_ns) wanted.batch_period_ns = period;
   }
   if (doc.contains("timing_hz")) {
     const auto rate = rate_of(doc, "timing_hz");
@@ -185,6 +196,7 @@ void ApiStream::receive(std::string_view text) {
     json ack{{"ok", true},
              {"variables", wanted_.variables},
              {"rate_hz", hz(wanted_.sample_period_ns)},
+             {"batch_hz", hz(wanted_.batch_period_ns)},
              {"timing_hz", hz(wanted_.timing_period_ns)},
              {"tasks", wanted_.timing_tasks},
              {"events", wanted_.events}};
@@ -200,6 +212,32 @@ std::string ApiStream::sample(const std::vector<std::string>& variables, std::ui
     values[v] = value ? json(*value) : json(nullptr);  // not written yet: null
   }
   return dump(json{{"kind", "sample"}, {"seq", seq}, {"t_ns", t_ns}, {"values", std::move(values)}});
+}
+
+void ApiStream::add_to_batch(Batch& batch, const std::vector<std::string>& variables, std::uint64_t seq,
+                             std::int64_t t_ns) const {
+  if (batch.count == 0) {
+    batch.first_seq = seq;
+    batch.t_ns = json::array();
+    batch.values = json::object();
+    for (const auto& v : variables) batch.values[v] = json::array();
+  }
+  batch.t_ns.push_back(t_ns);
+  for (const auto& v : variables) {
+    auto value = gate_.sample(v);
+    batch.values[v].push_back(value ? json(*value) : json(nullptr));  // not written yet: null
+  }
+  ++batch.count;
+}
+
+std::string ApiStream::take_batch(Batch& batch) {
+  std::string text = dump(json{{"kind", "samples"},
+                               {"seq", batch.first_seq},
+                               {"count", batch.count},
+                               {"t_ns", std::move(batch.t_ns)},
+                               {"values", std::move(batch.values)}});
+  batch.count = 0;
+  return text;
 }
 
 std::string ApiStream::timing(const std::vector<std::string>& tasks, std::uint64_t seq, std::int64_t t_ns) const {
@@ -238,6 +276,8 @@ bool ApiStream::send(const std::string& text) {
 void ApiStream::run() {
   using std::chrono::nanoseconds;
   Part samples;
+  Part batches;
+  Batch batch;
   Part timings;
   Part events;
   std::uint64_t cursor = 0;
@@ -254,6 +294,8 @@ void ApiStream::run() {
         wanted = wanted_;
         start = Clock::now();
         samples = Part{wanted.sample_period_ns, start, 0};
+        batches = Part{wanted.batch_period_ns, start + nanoseconds(wanted.batch_period_ns), 0};
+        batch.count = 0;  // the last subscription's samples go with it
         timings = Part{wanted.timing_period_ns, start, 0};
         events = Part{wanted.events ? kEventPollNs : 0, start, 0};
         cursor = gate_.feed().next_seq();  // what happens from now on
@@ -264,7 +306,7 @@ void ApiStream::run() {
       if (!ok) return;
       continue;
     }
-    const Clock::time_point wake = earliest({&samples, &timings, &events});
+    const Clock::time_point wake = earliest({&samples, &batches, &timings, &events});
     if (wake == Clock::time_point::max()) {
       changed_.wait(lock);
       continue;
@@ -275,8 +317,18 @@ void ApiStream::run() {
     const std::int64_t t_ns = std::chrono::duration_cast<nanoseconds>(now - start).count();
     bool ok = true;
     if (samples.due(now)) {
-      ok = send(sample(wanted.variables, samples.seq++, t_ns));  // blocks only this thread when the client reads slowly
+      if (wanted.batch_period_ns == 0) {
+        ok = send(
+            sample(wanted.variables, samples.seq++, t_ns));  // blocks only this thread when the client reads slowly
+      } else {
+        add_to_batch(batch, wanted.variables, samples.seq++, t_ns);
+        if (batch.count >= kMaxBatchSamples) ok = send(take_batch(batch));
+      }
       samples.advance(Clock::now());
+    }
+    if (ok && batches.due(now)) {
+      if (batch.count > 0) ok = send(take_batch(batch));
+      batches.advance(Clock::now());
     }
     if (ok && timings.due(now)) {
       ok = send(timing(wanted.timing_tasks, timings.seq++, t_ns));

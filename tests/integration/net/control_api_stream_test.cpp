@@ -151,6 +151,43 @@ TEST_F(ControlApiStreamTest, SamplesComeAtTheClientsRate) {
   EXPECT_GE(last - first, static_cast<std::int64_t>(frames.size() - 3) * 5'000'000);
 }
 
+// With batch_hz the samples come together: each "samples" frame holds the samples taken since the
+// last, numbered on from it, each variable's values one per sample, and none is left out.
+TEST_F(ControlApiStreamTest, BatchedSamplesComeTogetherAndNoneIsLeftOut) {
+  const auto frames =
+      stream_frames(port_, kViewer, R"({"variables": ["theta_m", "nosuch_yet"], "rate_hz": 500, "batch_hz": 20})", 1);
+  ASSERT_EQ(frames.size(), 1U);
+  EXPECT_EQ(frames[0]["error"]["code"], "not_found") << frames[0];  // checked whole, as without batches
+  const auto got =
+      stream_frames(port_, kViewer, R"({"variables": ["theta_m", "tau_r"], "rate_hz": 500, "batch_hz": 20})", 11);
+  ASSERT_GE(got.size(), 11U);
+  EXPECT_EQ(got[0]["ok"], true) << got[0];
+  EXPECT_EQ(got[0]["batch_hz"], 20.0);
+  std::uint64_t next = 0;
+  std::size_t samples = 0;
+  std::int64_t last_t = -1;
+  for (std::size_t i = 1; i < got.size(); ++i) {
+    const json& f = got[i];
+    ASSERT_EQ(f["kind"], "samples") << f;
+    ASSERT_EQ(f["seq"], next) << "a sample left out before frame " << i;
+    const std::size_t count = f["count"].get<std::size_t>();
+    ASSERT_GE(count, 1U);
+    ASSERT_LE(count, 1000U);
+    ASSERT_EQ(f["t_ns"].size(), count);
+    ASSERT_EQ(f["values"]["theta_m"].size(), count);
+    ASSERT_EQ(f["values"]["tau_r"].size(), count);
+    for (std::size_t k = 0; k < count; ++k) {
+      EXPECT_GT(f["t_ns"][k].get<std::int64_t>(), last_t);  // in order, each at its own time
+      last_t = f["t_ns"][k].get<std::int64_t>();
+      EXPECT_EQ(f["values"]["theta_m"][k].size(), 6U) << f;
+    }
+    next += count;
+    samples += count;
+  }
+  // Ten frames at 20 Hz of samples at 500 Hz: several samples a frame, never one frame each.
+  EXPECT_GT(samples, 2 * (got.size() - 1)) << samples << " samples in " << got.size() - 1 << " frames";
+}
+
 // A stream holds a server thread for as long as it is open. The server keeps one for each stream
 // it allows (32, HttpServer::kMaxStreams) beside its request threads: with every stream open the
 // API still answers at once, and one stream more is refused at once.
@@ -294,6 +331,9 @@ TEST_F(ControlApiStreamTest, SubscriptionsOfTimingAndEventsAreCheckedWhole) {
   const std::vector<std::pair<std::string, std::string>> refused = {
       {R"({"variables": ["theta_m"], "rate_hz": 10, "colour": "red"})", "bad_request"},
       {R"({"rate_hz": 10})", "bad_request"},
+      {R"({"batch_hz": 10})", "bad_request"},
+      {R"({"variables": ["theta_m"], "rate_hz": 10, "batch_hz": 0})", "bad_request"},
+      {R"({"variables": ["theta_m"], "rate_hz": 10, "batch_hz": "often"})", "bad_request"},
       {R"({"timing_hz": 50})", "bad_request"},
       {R"({"tasks": ["pid"]})", "bad_request"},
       {R"({"events": "yes"})", "bad_request"},
