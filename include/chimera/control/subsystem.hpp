@@ -171,8 +171,8 @@ class Subsystem {
   /// Replaces the subsystem with another file's (`next`, as the loader read it), keeping the run,
   /// its clock and options: every task is turned off and killed, the runtime is made anew for
   /// `next` and its `start` configuration turned on, as chimera run starts a file. Refused,
-  /// changing nothing, when `next` is not legal (its start configuration), pins a CPU this machine
-  /// lacks, or either subsystem has DDS exports or imports (the bridge is made for the first).
+  /// changing nothing, when `next` is not legal (its start configuration) or pins a CPU this
+  /// machine lacks. `chimera run`'s DDS bridge follows the new table to `next`'s exports and imports.
   Result<void> replace(SubsystemSpec next);
   /// The names of the configurations, in definition order. Any thread.
   [[nodiscard]] std::vector<std::string> configurations() const;
