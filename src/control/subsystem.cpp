@@ -310,6 +310,10 @@ std::int64_t Subsystem::now_ns() const {
 ClockKind Subsystem::clock() const { return impl_->options.clock; }
 const SubsystemSpec& Subsystem::spec() const { return impl_->spec; }
 const ResolvedSubsystem& Subsystem::resolved() const { return impl_->resolution.subsystem; }
+bool Subsystem::removed(std::size_t index) const {
+  std::lock_guard<std::mutex> notes(impl_->notes_mutex);
+  return index < impl_->removed.size() && impl_->removed[index];
+}
 const Registry& Subsystem::registry() const { return *impl_->registry; }
 
 bool Subsystem::illegal_configuration() const {

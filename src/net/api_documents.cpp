@@ -94,7 +94,9 @@ json module_library_json(const Registry& registry) {
 
 json subsystem_model_json(const Subsystem& subsystem) {
   json tasks = json::array();
-  for (const auto& t : subsystem.resolved().tasks) tasks.push_back(task_model_json(t));
+  const auto& resolved = subsystem.resolved().tasks;
+  for (std::size_t i = 0; i < resolved.size(); ++i)
+    if (!subsystem.removed(i)) tasks.push_back(task_model_json(resolved[i]));  // a removed task is gone
   json configurations = json::array();
   for (const auto& c : subsystem.spec().configurations) {
     json configuration{{"name", c.name}, {"tasks", c.tasks}};

@@ -122,6 +122,9 @@ class Subsystem {
   /// the commands).
   [[nodiscard]] const SubsystemSpec& spec() const;
   [[nodiscard]] const ResolvedSubsystem& resolved() const;
+  /// Whether the task at `index` of spec().tasks (and resolved().tasks) was removed by the live
+  /// assembly's `remove`: it stays in both, out of sight, until the next add or open rebuilds them.
+  [[nodiscard]] bool removed(std::size_t index) const;
   /// The module library its tasks are made from (and the live assembly adds from).
   [[nodiscard]] const Registry& registry() const;
   /// Whether the illegal-configuration flag is up now (paper 3.4). Any thread.

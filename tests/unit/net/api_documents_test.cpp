@@ -130,6 +130,16 @@ TEST(ApiDocuments, TheModelFollowsTheLiveAssembly) {
   ASSERT_FALSE(longer["violations"].empty());
   EXPECT_EQ(longer["violations"][0]["rule"], 1) << longer.dump();
   EXPECT_EQ(longer["violations"][0]["variable"], "doubled");
+
+  // A task removed is gone from the model, as from status and save.
+  auto extra = subsystem->add_task("{name: extra, module: test_counter, period: 1ms, rename: {count: extra_count}}");
+  ASSERT_TRUE(extra) << extra.error().message;
+  ASSERT_NE(find_named(subsystem_model_json(*subsystem)["tasks"], "name", "extra"), nullptr);
+  auto removed = subsystem->remove_task("extra");
+  ASSERT_TRUE(removed) << removed.error().message;
+  const json after = subsystem_model_json(*subsystem);
+  EXPECT_EQ(find_named(after["tasks"], "name", "extra"), nullptr) << after.dump();
+  EXPECT_NE(find_named(after["tasks"], "name", "third"), nullptr);
 }
 
 }  // namespace
