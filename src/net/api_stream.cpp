@@ -70,7 +70,7 @@ std::optional<Refusal> unknown_name(const Subscription& wanted, const ControlGat
 
 // The subscription a client's text asks for, or why it cannot be had: checked whole, so that a
 // refused one leaves the stream as it was.
-std::variant<Subscription, Refusal> parse_subscription(std::string_view text, const ControlGate& gate) {
+std::variant<Subscription, Refusal> parse_subscription(std::string_view text, ControlGate& gate) {
   const json doc = json::parse(text, nullptr, false);
   if (doc.is_discarded() || !doc.is_object()) return Refusal{"bad_request", std::string(kUsage)};
   for (const auto& [key, value] : doc.items())
@@ -92,6 +92,12 @@ std::variant<Subscription, Refusal> parse_subscription(std::string_view text, co
                                                 ApiStream::kMaxRateHz)};
     if (wanted.variables.empty()) return Refusal{"bad_request", "rate_hz without variables to sample"};
     wanted.sample_period_ns = std::llround(1e9 / *rate);
+  }
+  if (wanted.sample_period_ns > 0) {
+    // Up to the writers' rate: asked faster, a stream would send each value several times (the
+    // ack says the rate it sends at).
+    const std::int64_t writers = gate.fastest_writer_period_ns(wanted.variables);
+    wanted.sample_period_ns = std::max(wanted.sample_period_ns, writers);
   }
   if (doc.contains("batch_hz")) {
     const auto batch = rate_of(doc, "batch_hz");

@@ -313,6 +313,11 @@ ApiResponse ControlApi::command(Role role, std::string_view body) {
                  "save FILE writes on the server's machine: over the network send save alone; the reply's yaml is the "
                  "file");
 
+  if (c.verb == Verb::kDump && !c.args.empty())
+    return error(400, "bad_command",
+                 "dump DIR writes where DIR says on the server's machine: over the network send dump alone; it goes "
+                 "below the run's dump directory (--dump-dir)");
+
   auto [r, extra] = gate_.exclusive([&](Control& control, Subsystem& subsystem) {
     Reply done = control.execute(c);
     json more = json::object();

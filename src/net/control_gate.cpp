@@ -25,6 +25,27 @@ std::string ControlGate::drain_events() {
   return event_lines(events);
 }
 
+std::int64_t ControlGate::fastest_writer_period_ns(const std::vector<std::string>& variables) {
+  std::lock_guard<std::mutex> lock(mutex_);  // the live assembly's add and open change the tasks
+  std::int64_t fastest = 0;
+  for (const auto& variable : variables) {
+    std::int64_t writer = 0;  // this variable's fastest periodic writer
+    const auto& tasks = subsystem_.resolved().tasks;
+    for (std::size_t i = 0; i < tasks.size(); ++i) {
+      const ResolvedTask& task = tasks[i];
+      if (subsystem_.removed(i)) continue;
+      const bool writes = std::any_of(task.bindings.begin(), task.bindings.end(), [&](const PortBinding& b) {
+        return b.kind == PortKind::kOutVar && b.variable == variable;
+      });
+      if (writes && task.spec->period_ns && (writer == 0 || *task.spec->period_ns < writer))
+        writer = *task.spec->period_ns;
+    }
+    if (writer == 0) return 0;
+    if (fastest == 0 || writer < fastest) fastest = writer;
+  }
+  return fastest;
+}
+
 void ControlGate::run_for(std::int64_t ns) {
   if (subsystem_.clock() == ClockKind::kReal) {
     subsystem_.run_for(ns);  // a sleep: the tasks run on their own threads meanwhile

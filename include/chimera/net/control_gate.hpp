@@ -59,6 +59,12 @@ class ControlGate {
   /// thread and reads the table as any reader does, so a stream never waits for a command.
   [[nodiscard]] Result<std::vector<double>> sample(std::string_view variable) const { return subsystem_.get(variable); }
 
+  /// The shortest period of the periodic tasks that write any of `variables` (their out-var
+  /// ports, after renames, in any configuration): the fastest any of them changes, and so the
+  /// fastest a stream samples them. 0 when one of them has no periodic writer (an aperiodic task,
+  /// the operator's `set`, a DDS import): how often it changes is not known. Takes the gate.
+  [[nodiscard]] std::int64_t fastest_writer_period_ns(const std::vector<std::string>& variables);
+
   /// The subsystem's clock; fixed at creation, so no lock.
   [[nodiscard]] ClockKind clock() const { return subsystem_.clock(); }
 

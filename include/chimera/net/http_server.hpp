@@ -26,8 +26,9 @@ class HttpServer {
   /// connection is dropped: a stalled or slow client frees its thread after this.
   static constexpr int kRequestTimeoutMs = 5000;
   /// Open WebSocket streams at most (each has a thread of its own, and holds a server thread
-  /// beside the request threads); more are refused at once.
-  static constexpr int kMaxStreams = 32;
+  /// beside the request threads); more are refused at once. An Onika page holds two: 64 pages
+  /// open at once, or a hundred scripts' streams.
+  static constexpr int kMaxStreams = 128;
 
   /// Listens on `address` and serves `api` until stop() or destruction. `api` must outlive
   /// the server. An address that cannot be bound is an Errc::kSystem error naming it.

@@ -9,6 +9,8 @@
 
 #include <atomic>
 #include <csignal>
+#include <filesystem>
+#include <map>
 #include <string>
 #include <thread>
 #include <vector>
@@ -536,8 +538,12 @@ TEST_F(ControlApiHttpTest, LiveAssemblyOverHttp) {
   const HttpResponse robot = http(port_, add_robot);
   EXPECT_REPLY(robot, 200);
   EXPECT_EQ(body_of(robot)["task"], "robot");
-  EXPECT_REPLY(run("add {name: traj, module: joint_traj_gen, period: 1ms, criticality: soft}"), 200);
+  // With a parameter and a rename, as a file's entry has them: traj's theta_d is theta_ref here.
+  EXPECT_REPLY(run("add {name: traj, module: joint_traj_gen, period: 1ms, criticality: soft, "
+                   "params: {segment_time: 1.5}, rename: {theta_d: theta_ref}}"),
+               200);
   EXPECT_REPLY(run("add {name: traj, module: joint_traj_gen, period: 1ms}"), 409);  // already there
+  EXPECT_REPLY(run("add {name: bad, module: joint_traj_gen, period: 1ms, params: {segment_time: 0}}"), 409);
   EXPECT_REPLY(run("add {name: x, module: cpu_load}", kViewer), 403);
   // define and verify: the set difference, and nothing switched.
   const HttpResponse defined = run("define fig4 traj robot");
@@ -552,7 +558,8 @@ TEST_F(ControlApiHttpTest, LiveAssemblyOverHttp) {
   EXPECT_EQ(v["violations"][0]["variable"], "tau_r");
   EXPECT_EQ(v["violations"][0]["reason"], "tau_r has no producer (read by robot)");
   EXPECT_REPLY(run("switch fig4"), 409);
-  EXPECT_REPLY(run("add {name: pid, module: pid_joint, period: 1ms}"), 200);
+  EXPECT_REPLY(run("add {name: pid, module: pid_joint, period: 1ms, params: {kp: [40]}, rename: {theta_d: theta_ref}}"),
+               200);
   EXPECT_REPLY(run("add {name: spare, module: cpu_load, period: 10ms}"), 200);
   EXPECT_REPLY(run("define fig4 traj pid robot"), 200);
   EXPECT_EQ(body_of(run("verify fig4"))["legal"], true);
@@ -570,6 +577,47 @@ TEST_F(ControlApiHttpTest, LiveAssemblyOverHttp) {
   write_text(path, body_of(saved)["yaml"].get<std::string>());
   const auto checked = run_chimera(dir_, "verify " + path);
   EXPECT_EQ(checked.exit_code, 0) << checked.out << checked.err;
+  // ... and starts the same subsystem: the same tasks (modules, periods, parameters, ports bound
+  // to the same variables), the same configurations, the same one on.
+  const json assembled = body_of(http(port_, HttpRequest{"GET", "/api/subsystem", kViewer}))["subsystem"];
+  EXPECT_REPLY(run("quit"), 200);
+  EXPECT_EQ(p->wait_exit(), 0) << p->err();
+  const TempDir second;  // its own output files: the first run's name its port too
+  auto again = std::make_unique<ChimeraProcess>(
+      second, std::vector<std::string>{"run", path, "--listen", "127.0.0.1:0", "--token-file", token_file()});
+  port_ = again->port();
+  ASSERT_GT(port_, 0) << again->err();
+  const HttpResponse model = http(port_, HttpRequest{"GET", "/api/subsystem", kViewer});
+  EXPECT_REPLY(model, 200);
+  const json started = body_of(model)["subsystem"];
+  ASSERT_TRUE(started.is_object()) << model.body << again->err();
+  ASSERT_EQ(assembled["tasks"].size(), 3U) << assembled;
+  EXPECT_EQ(started["tasks"], assembled["tasks"]);
+  EXPECT_EQ(started["configurations"], assembled["configurations"]);
+  EXPECT_EQ(started["configuration"], "fig4");
+  EXPECT_EQ(states(port_), (std::map<std::string, std::string>{{"traj", "ON"}, {"pid", "ON"}, {"robot", "ON"}}));
+  EXPECT_REPLY(run("quit"), 200);
+  EXPECT_EQ(again->wait_exit(), 0) << again->err();
+}
+
+// dump over the network: the recorder's last seconds go below the run's dump directory; DIR, a
+// path anywhere on the server's machine, is refused as save FILE is, and a viewer may not write.
+TEST_F(ControlApiHttpTest, DumpWritesBelowTheRunsDumpDirectory) {
+  const std::string dumps = dir_.file("dumps");
+  auto p = start("virtual", {"--record", "1s", "--dump-dir", dumps});
+  ASSERT_GT(port_, 0) << p->err();
+  EXPECT_REPLY(run("wait 200ms"), 200);
+  EXPECT_REPLY(run("dump", kViewer), 403);
+  EXPECT_REPLY(run("dump " + dir_.file("elsewhere")), 400);
+  EXPECT_FALSE(std::filesystem::exists(dir_.file("elsewhere")));
+  const HttpResponse dumped = run("dump");
+  EXPECT_REPLY(dumped, 200);
+  const std::string text = body_of(dumped)["text"];
+  EXPECT_TRUE(contains(text, dumps + "/")) << text;
+  std::size_t written = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dumps))
+    if (std::filesystem::is_regular_file(entry.path() / "variables.csv")) ++written;
+  EXPECT_EQ(written, 1U);
   EXPECT_REPLY(run("quit"), 200);
   EXPECT_EQ(p->wait_exit(), 0) << p->err();
 }

@@ -151,6 +151,23 @@ TEST_F(ControlApiStreamTest, SamplesComeAtTheClientsRate) {
   EXPECT_GE(last - first, static_cast<std::int64_t>(frames.size() - 3) * 5'000'000);
 }
 
+// Up to the writers' rate: theta_d is written only by the 10 ms traj, so asked at 1 kHz it comes
+// at 100 Hz (the ack says so, and the samples are 10 ms apart at least); with theta_m beside it,
+// written by the 1 ms robot, at the rate asked.
+TEST_F(ControlApiStreamTest, SamplesComeNoFasterThanTheirFastestWriter) {
+  const auto slow = stream_frames(port_, kViewer, R"({"variables": ["theta_d"], "rate_hz": 1000})", 6);
+  ASSERT_GE(slow.size(), 6U);
+  EXPECT_EQ(slow[0]["ok"], true) << slow[0];
+  EXPECT_EQ(slow[0]["rate_hz"], 100.0) << slow[0];
+  const auto first = slow[1]["t_ns"].get<std::int64_t>();
+  // Four grid points of 10 ms after the first sample, which may itself have been taken late: at
+  // least three periods (at 1 kHz, four samples would be 4 ms apart).
+  EXPECT_GE(slow.back()["t_ns"].get<std::int64_t>() - first, 3 * 10'000'000);
+  const auto both = stream_frames(port_, kViewer, R"({"variables": ["theta_d", "theta_m"], "rate_hz": 1000})", 1);
+  ASSERT_GE(both.size(), 1U);
+  EXPECT_EQ(both[0]["rate_hz"], 1000.0) << both[0];
+}
+
 // With batch_hz the samples come together: each "samples" frame holds the samples taken since the
 // last, numbered on from it, each variable's values one per sample, and none is left out.
 TEST_F(ControlApiStreamTest, BatchedSamplesComeTogetherAndNoneIsLeftOut) {
@@ -189,10 +206,10 @@ TEST_F(ControlApiStreamTest, BatchedSamplesComeTogetherAndNoneIsLeftOut) {
 }
 
 // A stream holds a server thread for as long as it is open. The server keeps one for each stream
-// it allows (32, HttpServer::kMaxStreams) beside its request threads: with every stream open the
+// it allows (128, HttpServer::kMaxStreams) beside its request threads: with every stream open the
 // API still answers at once, and one stream more is refused at once.
 TEST_F(ControlApiStreamTest, TheMostStreamsLeaveRequestsServedAndOneMoreIsRefused) {
-  constexpr int kMostStreams = 32;
+  constexpr int kMostStreams = 128;
   std::vector<std::unique_ptr<Received>> received;
   std::vector<mg_connection*> streams;
   for (int i = 0; i < kMostStreams; ++i) {
