@@ -79,6 +79,7 @@ export class Plot {
     this.reset(false);
     for (const [name, v] of log.series) this.lines.set(name, { t: log.t, v });
     this.canvas.dataset.samples = String(log.t.length);
+    this.canvas.dataset.series = [...log.series.keys()].join(',');
     this.draw();
   }
 

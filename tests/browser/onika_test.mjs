@@ -120,6 +120,11 @@ test('assembles Figure 4 from an empty canvas, runs it, plots it and saves a fil
     assert.ok(!producers.includes('robot_torque'), 'robot_torque consumes tau_r, it does not produce it');
     await page.click('#library-list li[data-module="pid_joint"]');
     await page.waitForSelector('#details article.module-page[data-module="pid_joint"]');
+    // ... and by name: a part of a module's name finds it.
+    await page.fill('#library-search', 'traj');
+    const named = await page.$$eval('#library-list li', (items) => items.map((i) => i.dataset.module));
+    assert.ok(named.includes('joint_traj_gen'), `'traj' finds joint_traj_gen: ${named}`);
+    assert.ok(!named.includes('pid_joint'), `'traj' does not find pid_joint: ${named}`);
     await page.fill('#library-search', '');
 
     // Soft tasks: a shared test machine may miss a deadline, which is the next test's subject.
@@ -144,9 +149,14 @@ test('assembles Figure 4 from an empty canvas, runs it, plots it and saves a fil
     for (const [from, to, variable] of [['traj', 'pid', 'theta_d'], ['pid', 'robot', 'tau_r'], ['robot', 'pid', 'theta_m']])
       assert.ok(await page.$(`#canvas path.link[data-from="${from}"][data-to="${to}"][data-variable="${variable}"]`), `${from} -> ${to} (${variable})`);
     assert.equal(await page.$$eval('#canvas .bad', (n) => n.length), 0, 'nothing is highlighted once legal');
+    // The tracking monitor beside them (Figure 4's tracking error): theta_d and theta_m fan out to it.
+    await dragIn(page, 'tracking_monitor', 'monitor', { criticality: 'soft' });
+    await page.waitForFunction(() => document.querySelector('#verdict').textContent === 'legal');
+    for (const [from, variable] of [['traj', 'theta_d'], ['robot', 'theta_m']])
+      assert.ok(await page.$(`#canvas path.link[data-from="${from}"][data-to="monitor"][data-variable="${variable}"]`), `${from} -> monitor (${variable})`);
 
     await page.click('#switch');
-    for (const task of ['traj', 'pid', 'robot']) await waitForState(page, task, 'ON');
+    for (const task of ['traj', 'pid', 'robot', 'monitor']) await waitForState(page, task, 'ON');
     // The switch and the states it changed come as events, in the shell's words.
     await page.waitForSelector('#events li[data-type="switch"]', { timeout: 15000 });
     assert.match(await page.textContent('#events li[data-type="switch"]'), /switch empty → assembly \(operator\): on [a-z ]*pid/);
@@ -162,17 +172,35 @@ test('assembles Figure 4 from an empty canvas, runs it, plots it and saves a fil
     await page.screenshot({ path: join(shots, 'onika-timing.png') });
     const status = await apiStatus(link);
     assert.equal(status.configuration, 'assembly');
-    assert.deepEqual(status.tasks.map((t) => t.state), ['ON', 'ON', 'ON']);
+    assert.deepEqual(status.tasks.map((t) => t.state), ['ON', 'ON', 'ON', 'ON']);
 
-    // A live plot of the arm's joints: samples arrive and the values move.
-    await page.selectOption('#plot-variables', ['theta_d', 'theta_m']);
+    // A live plot of the arm's joints and the tracking error: samples arrive and the values move.
+    await page.selectOption('#plot-variables', ['theta_d', 'theta_m', 'tracking_error']);
     await page.fill('#plot-rate', '200');
     await page.click('#plot-live');
     await page.waitForFunction(() => Number(document.querySelector('#plot').dataset.samples || 0) > 50, null, { timeout: 15000 });
     // The trajectory loops (loop: true): the arm is moving or about to, whenever the plot starts.
     const first = await page.$eval('#plot', (c) => c.dataset.latest);
     await page.waitForFunction((seen) => document.querySelector('#plot').dataset.latest !== seen, first, { timeout: 15000 });
+    const latest = JSON.parse(await page.$eval('#plot', (c) => c.dataset.latest));
+    assert.equal(latest.tracking_error.length, 3, `the tracking error is plotted: ${JSON.stringify(latest)}`);
     await page.screenshot({ path: join(shots, 'onika-fig4.png') });
+
+    // A recorded run: the data logger's CSV of Figure 4 (two seconds on the virtual clock), opened
+    // in the same plot, every row of it, a line per column.
+    const logs = join(work, 'fig4-log');
+    mkdirSync(logs, { recursive: true });
+    const logged = spawnSync(chimera, ['run', join(source, 'examples', 'fig4_pid_joint.yaml'), '--clock', 'virtual', '--for', '2s'],
+      { encoding: 'utf8', env: { ...process.env, CHIMERA_LOG_DIR: logs } });
+    assert.equal(logged.status, 0, `${logged.stdout}${logged.stderr}`);
+    const csv = join(logs, 'fig4.csv');
+    const rows = readFileSync(csv, 'utf8').trim().split('\n').length - 1;
+    assert.ok(rows >= 1990, `two seconds of rows at 1 kHz: ${rows}`);
+    await page.setInputFiles('#plot-file', csv);
+    await page.waitForFunction((n) => Number(document.querySelector('#plot').dataset.samples) === n, rows, { timeout: 15000 });
+    const series = (await page.$eval('#plot', (c) => c.dataset.series)).split(',');
+    assert.ok(series.includes('tracking_error[0]') && series.includes('theta_m[5]'), `the log's columns: ${series}`);
+    assert.equal(await page.textContent('#plot-state'), 'fig4.csv');
 
     // Save: the file the page shows is one chimera verify accepts.
     await page.click('#save');
@@ -227,11 +255,29 @@ test('a task\'s parameters edited on the canvas, a refusal changing nothing; its
     await page.click('#edit-apply');
     await page.waitForFunction(() => document.querySelector('#edit-params') && document.querySelector('#edit-params').value.includes('"segment_time":3'));
     await page.waitForFunction(() => document.querySelector('#verdict').textContent === 'legal');
+
+    // A rename edited on a port: traj's output theta_d bound to theta_ref leaves pid's theta_d
+    // without a producer, said in words and drawn in red; pid's input bound to it too, and the
+    // link is drawn again, under the new name.
+    const renameTo = (variable) => page.once('dialog', (d) => d.accept(variable));
+    renameTo('theta_ref');
+    await page.click('#canvas g.task[data-task="traj"] g.port[data-port="theta_d"]');
+    // traj is added anew with the rename (taken out of the configuration meanwhile): the port shows it.
+    await page.waitForSelector('#canvas g.task[data-task="traj"] g.port.renamed[data-port="theta_d"][data-variable="theta_ref"]', { timeout: 15000 });
+    await page.waitForFunction(() => document.querySelector('#verdict').textContent.includes('theta_d has no producer'));
+    assert.ok(await page.$('#canvas g.task[data-task="pid"] g.port.bad[data-port="theta_d"]'), "pid's theta_d is red");
+    renameTo('theta_ref');
+    await page.click('#canvas g.task[data-task="pid"] g.port[data-port="theta_d"]');
+    await page.waitForSelector('#canvas g.task[data-task="pid"] g.port.renamed[data-port="theta_d"][data-variable="theta_ref"]', { timeout: 15000 });
+    await page.waitForFunction(() => document.querySelector('#verdict').textContent === 'legal');
+    assert.ok(await page.$('#canvas path.link[data-from="traj"][data-to="pid"][data-variable="theta_ref"]'), 'traj -> pid (theta_ref)');
+
     await page.click('#save');
     await page.waitForSelector('#save-dialog[open]');
     const yaml = await page.inputValue('#save-text');
     await page.click('#save-close');
     assert.match(yaml, /segment_time: 3/, yaml);
+    assert.match(yaml, /rename: *\{ *theta_d: theta_ref *\}|rename:\s*\n\s+theta_d: theta_ref/, yaml);
     assert.match(yaml, /name: traj[^\n]*\n(?:[^\n]*\n)*?\s+period: 2ms/, yaml);
 
     // The box moved by hand: where it is let go (on the grid), the links following it; after a
@@ -249,7 +295,7 @@ test('a task\'s parameters edited on the canvas, a refusal changing nothing; its
     assert.ok(moved.y > before.y + 40, `moved down: ${JSON.stringify(before)} -> ${JSON.stringify(moved)}`);
     assert.equal(moved.x % 10, 0);
     assert.equal(moved.y % 10, 0);
-    assert.ok(await page.$('#canvas path.link[data-from="traj"][data-to="pid"][data-variable="theta_d"]'), 'the link follows the box');
+    assert.ok(await page.$('#canvas path.link[data-from="traj"][data-to="pid"][data-variable="theta_ref"]'), 'the link follows the box');
     await page.reload();
     await page.waitForSelector('body[data-ready=true]', { timeout: 15000 });
     await page.click('#configuration-tabs button[data-configuration="assembly"]');
@@ -284,10 +330,14 @@ test('a task in ERROR shows its message and the clear button brings it back', as
     await page.waitForSelector('#events li[data-type="state"][data-task="load"]:has-text("→ ERROR")', { timeout: 15000 });
     assert.match(await page.textContent('#events li[data-type="state"][data-task="load"]:has-text("→ ERROR")'), /load: (ON|NOT-CREATED) → ERROR/);
     assert.ok(await page.$('#canvas g.task.state-ERROR[data-task="load"]'), 'the canvas shows ERROR by colour');
+    // While a task is in ERROR the illegal-configuration flag is up (docs/lifecycle.md), in the header.
+    await page.waitForSelector('#illegal-flag:not([hidden])', { timeout: 15000 });
+    assert.equal((await apiStatus(link)).illegal_configuration, true);
     await page.screenshot({ path: join(shots, 'onika-error.png') });
     await page.click('#tasks tr[data-task="load"] button[data-action="clear"]');
     await waitForState(page, 'load', 'OFF');
     assert.equal((await apiStatus(link)).tasks[0].state, 'OFF');
+    await page.waitForSelector('#illegal-flag[hidden]', { state: 'attached', timeout: 15000 });
     assert.deepEqual(problems, []);
   } finally {
     await context.close();
