@@ -324,8 +324,8 @@ void ApiStream::run() {
     bool ok = true;
     if (samples.due(now)) {
       if (wanted.batch_period_ns == 0) {
-        ok = send(
-            sample(wanted.variables, samples.seq++, t_ns));  // blocks only this thread when the client reads slowly
+        // Blocks only this thread when the client reads slowly.
+        ok = send(sample(wanted.variables, samples.seq++, t_ns));
       } else {
         add_to_batch(batch, wanted.variables, samples.seq++, t_ns);
         if (batch.count >= kMaxBatchSamples) ok = send(take_batch(batch));
