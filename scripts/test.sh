@@ -8,7 +8,8 @@
 #                      labelled realtime or benchmark (timing means nothing under ASAN)
 #   tsan  build-tsan/  ThreadSanitizer; the tests labelled concurrency, and only what they need, are
 #                      built and run, except those also labelled realtime (their timing cannot
-#                      hold in a build 5 to 15 times slower: a hard task misses its first deadline)
+#                      hold in a build 5 to 15 times slower: a hard task misses its first deadline;
+#                      sanitizer trees do not build them either)
 #   fuzz  build-fuzz/  clang, libFuzzer + ASAN + UBSAN: only the fuzz targets of tests/fuzz are
 #                      built; each fuzzes for FUZZ_SECONDS (default here 15) from its seed corpus
 #                      and fails on any crash, leak or hang (`make fuzz`: 60 s each)

@@ -36,6 +36,7 @@ class JoinWeightedAverage final : public Module {
 
   static void declare(Declarations& d, const Params& p) {
     const int n = input_count(p);
+    d.join_connector();
     for (int i = 0; i < n; ++i)
       d.in_var(input_name(i), Dim::follow(),
                "one producer's value of the quantity (rename it to that producer's variable)");

@@ -2,7 +2,9 @@
 // input ports on the left and its outputs on the right, and a link wherever an output and an
 // input are bound to the same state variable. Nobody draws a wire: the links follow from the
 // port names and the renames, which is the methodology's point. Fan-out is one output drawn to
-// several inputs; a variable with no producer, or with two, is drawn in red with the reason.
+// several inputs; a join connector (Figure 3: several producers of one quantity, renamed apart,
+// merged into one output) is drawn as a funnel whose inputs converge on its one output; a
+// variable with no producer, or with two, is drawn in red with the reason.
 // Boxes are placed from the data flow; one dragged elsewhere stays where it was put (the
 // `layout` the page keeps per configuration), and the links follow it.
 
@@ -17,6 +19,7 @@ const GAP = 36;
 const MARGIN = 40;
 const SNAP = 10; // a moved box lands on this grid
 const DRAG_START = 4; // a press that moves less is a click
+const FUNNEL = 28; // a join connector's pointed end, where its inputs meet
 
 /** The links of a configuration: output to input of the same variable, and what has no end. */
 export function linksOf(tasks) {
@@ -114,7 +117,7 @@ export class Canvas {
       const c = column[i];
       const y = heights[c] || MARGIN;
       heights[c] = y + h + GAP;
-      place.set(t.name, { x: MARGIN + c * COLUMN, y, h, ins, outs });
+      place.set(t.name, { x: MARGIN + c * COLUMN, y, h, ins, outs, join: t.connector === 'join' });
     });
     const moved = this.layout ? this.layout.get(configuration.name) : {};
     for (const [name, at] of place) {
@@ -123,7 +126,10 @@ export class Canvas {
     }
     const boxes = [...place.values()];
     const bottom = Math.max(...boxes.map((b) => b.y + b.h));
-    const portY = (box, list, p) => box.y + HEADER + list.indexOf(p) * ROW + ROW / 2;
+    // A join's one output is at its point, half-way down; every other port on its row.
+    const portY = (box, list, p) =>
+      box.join && list === box.outs && list.length === 1 ? box.y + box.h / 2 : box.y + HEADER + list.indexOf(p) * ROW + ROW / 2;
+    this.portY = portY;
     const linkLayer = svg('g', { class: 'links' });
     const boxLayer = svg('g', { class: 'boxes' });
     let loop = 0;
@@ -223,8 +229,18 @@ export class Canvas {
       'data-y': at.y,
     });
     const period = task.period_ns === null ? 'aperiodic' : durationText(task.period_ns);
+    const w = BOX_WIDTH;
+    // A join connector: a funnel pointing at its output, as the paper's Figure 3 merges p' and p''.
+    const body = at.join
+      ? svg('polygon', {
+          points: `${at.x},${at.y} ${at.x + w - FUNNEL},${at.y} ${at.x + w},${at.y + at.h / 2} ${at.x + w - FUNNEL},${at.y + at.h} ${at.x},${at.y + at.h}`,
+          class: 'task-box join',
+        })
+      : svg('rect', { x: at.x, y: at.y, width: w, height: at.h, rx: 6, class: 'task-box' });
+    if (at.join) g.classList.add('join');
+    if (at.join) g.append(svg('title', {}, `${task.name}: a join connector, one value of the quantity from its ${at.ins.length} producers`));
     g.append(
-      svg('rect', { x: at.x, y: at.y, width: BOX_WIDTH, height: at.h, rx: 6, class: 'task-box' }),
+      body,
       svg('text', { x: at.x + 10, y: at.y + 15, class: 'task-name' }, task.name),
       svg('text', { x: at.x + 10, y: at.y + 28, class: 'task-module' }, `${task.module} · ${period} · ${state || 'NOT-CREATED'}`),
     );
@@ -232,7 +248,7 @@ export class Canvas {
     g.addEventListener('click', (event) => !event.target.closest('.port') && !this.justMoved && this.onTask && this.onTask(task));
     if (this.layout) this.draggable(g, task, at, configuration);
     const port = (p, i, left) => {
-      const y = at.y + HEADER + i * ROW + ROW / 2;
+      const y = this.portY(at, left ? at.ins : at.outs, p);
       const x = left ? at.x : at.x + BOX_WIDTH;
       const cls = `port port-${p.kind}${bad.has(p.variable) ? ' bad' : ''}${p.renamed ? ' renamed' : ''}`;
       const label = p.renamed ? `${p.port} → ${p.variable}` : p.port;

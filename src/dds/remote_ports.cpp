@@ -399,10 +399,11 @@ void RemotePorts::Impl::judge_staleness() {
                                           port.status.writer.empty() ? std::string("a writer without a Chimera stamp")
                                                                      : "subsystem " + port.status.writer));
     }
+    // Under the status lock: no one reads "stale" before the flag it says is raised is up.
+    if (!options.hold_when_stale) return;
+    if (any_stale && !stale_hold) stale_hold.emplace(table);
+    if (!any_stale) stale_hold.reset();
   }
-  if (!options.hold_when_stale) return;
-  if (any_stale && !stale_hold) stale_hold.emplace(table);
-  if (!any_stale) stale_hold.reset();
 }
 
 void RemotePorts::Impl::take_loop() {

@@ -47,6 +47,7 @@ json module_json(const Registry& registry, const ModuleInfo& m) {
               {"doc", m.doc},
               {"library", registry.origin(m.name)},
               {"resource", decls.resource()},
+              {"connector", decls.is_join_connector() ? "join" : ""},
               {"ports", std::move(ports)},
               {"params", std::move(params)}};
 }
@@ -67,7 +68,8 @@ json task_model_json(const ResolvedTask& t) {
                          {"renamed", b.port != b.variable}});
   json task{{"name", spec.name},       {"module", spec.module},    {"criticality", criticality_name(spec.criticality)},
             {"process", spec.process}, {"sized", t.sized},         {"params", std::move(params)},
-            {"rename", spec.rename},   {"ports", std::move(ports)}};
+            {"rename", spec.rename},   {"ports", std::move(ports)},
+            {"connector", t.decls.is_join_connector() ? "join" : ""}};
   task["period_ns"] = spec.period_ns ? json(*spec.period_ns) : json(nullptr);
   task["cpu"] = spec.cpu ? json(*spec.cpu) : json(nullptr);
   return task;

@@ -387,6 +387,39 @@ test('Figures 8 and 9: two configurations of one file side by side, switched wit
   }
 });
 
+test("Figure 3's join connector: drawn as a funnel, its two producers' links converging on it", async () => {
+  // examples/fig3_join.yaml under a name of its own (a test of the examples may run it meanwhile)
+  // and with every task soft: a shared test machine may miss a deadline, not this test's subject.
+  const example = readFileSync(join(source, 'examples', 'fig3_join.yaml'), 'utf8');
+  const name = `onika_join_${process.pid}`;
+  const text = example.replace('\nsubsystem: fig3_join\n', `\nsubsystem: ${name}\n`).replace(/( {4}period: \S+\n)(?! {4}criticality)/g, '$1    criticality: soft\n');
+  assert.ok(text.includes(`subsystem: ${name}\n`) && (text.match(/criticality: soft/g) || []).length === 6, 'the example changed: adapt this test');
+  const file = join(work, 'fig3_join.yaml');
+  writeFileSync(file, text);
+  const run = startChimera(['run', file, '--listen', '127.0.0.1:0'], 'fig3');
+  const link = await run.link;
+  const { page, context, problems } = await openPage(link);
+  try {
+    await page.waitForSelector('#canvas g.task.join[data-task="join"] polygon.task-box.join');
+    // Only the join is drawn so: the cameras and the rest are boxes.
+    assert.deepEqual(await page.$$eval('#canvas g.task.join', (gs) => gs.map((g) => g.dataset.task)), ['join']);
+    assert.ok(await page.$('#canvas g.task[data-task="camera_a"] rect.task-box'), 'a camera is a box');
+    const into = await page.$$eval('#canvas path.link[data-to="join"]', (ps) => ps.map((p) => `${p.dataset.from}:${p.dataset.variable}`).sort());
+    assert.deepEqual(into, ['camera_a:x_d_a', 'camera_b:x_d_b']);
+    // Its one output leaves from the funnel's point.
+    const [tipX, tipY] = await page.$eval('#canvas g.task[data-task="join"] polygon', (p) => [p.points[2].x, p.points[2].y]);
+    const start = await page.$eval('#canvas path.link[data-from="join"][data-to="ik"]', (p) => p.getAttribute('d').match(/^M([-\d.]+),([-\d.]+)/).slice(1).map(Number));
+    assert.deepEqual(start, [tipX, tipY], 'x_d starts at the point of the join');
+    assert.equal(await page.$eval('#canvas path.link[data-from="join"][data-to="ik"]', (p) => p.dataset.variable), 'x_d');
+    await waitForState(page, 'join', 'ON');
+    await page.screenshot({ path: join(shots, 'onika-fig3-join.png') });
+    assert.deepEqual(problems, []);
+  } finally {
+    await context.close();
+    await stopChimera(run);
+  }
+});
+
 test('opens an example of the tree from the page, edited in place, and it runs', async () => {
   const run = startChimera(['serve', '--listen', '127.0.0.1:0'], 'open');
   const link = await run.link;

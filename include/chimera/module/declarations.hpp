@@ -93,16 +93,21 @@ class Declarations {
 
   /// What the module's resource port talks to (hardware, a simulation, a socket), for docs.
   void resource(std::string what) { resource_ = std::move(what); }
+  /// The module is a join connector (the paper's Figure 3): it merges several producers of one
+  /// quantity into one output, and Onika draws it as the paper does, not as a module's box.
+  void join_connector() { join_connector_ = true; }
 
   [[nodiscard]] const std::vector<PortDecl>& ports() const { return ports_; }
   [[nodiscard]] const std::vector<ParamDecl>& params() const { return params_; }
   [[nodiscard]] const std::string& resource() const { return resource_; }
+  [[nodiscard]] bool is_join_connector() const { return join_connector_; }
 
  private:
   std::vector<PortDecl> ports_;
   std::vector<ParamDecl> params_;
   std::vector<std::string> problems_;
   std::string resource_;
+  bool join_connector_ = false;
 };
 
 }  // namespace chimera

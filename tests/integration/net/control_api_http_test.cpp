@@ -519,6 +519,9 @@ TEST_F(ControlApiHttpTest, ServeStartsAnEmptySubsystem) {
   const HttpResponse modules = http(port_, HttpRequest{"GET", "/api/modules", kViewer});
   EXPECT_REPLY(modules, 200);
   EXPECT_GT(body_of(modules)["modules"].size(), 10U);
+  // The join connector is marked as one (Onika draws it as the paper's Figure 3 does); nothing else is.
+  for (const auto& m : body_of(modules)["modules"])
+    EXPECT_EQ(m["connector"], m["name"] == "join_weighted_average" ? "join" : "") << m["name"];
   const HttpResponse model = http(port_, HttpRequest{"GET", "/api/subsystem", kViewer});
   EXPECT_REPLY(model, 200);
   EXPECT_EQ(body_of(model)["subsystem"]["configuration"], "empty");

@@ -94,6 +94,7 @@ TEST(ApiDocuments, TheModelBindsPortsAfterRenamesAndVerifiesEveryConfiguration) 
   EXPECT_EQ(spare["rename"], (json{{"count", "spare_count"}}));
   EXPECT_EQ(spare["cpu"], 0);
   EXPECT_EQ(spare["period_ns"], 1'000'000);
+  EXPECT_EQ(spare["connector"], "");  // not a join connector (tests/integration/net checks one that is)
 
   const json& doubler = *find_named(model["tasks"], "name", "doubler");
   EXPECT_EQ(doubler["criticality"], "soft");
