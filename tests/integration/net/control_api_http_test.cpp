@@ -518,9 +518,10 @@ TEST_F(ControlApiHttpTest, ServeStartsAnEmptySubsystem) {
   EXPECT_EQ(http(port_, HttpRequest{"GET", "/api/modules", ""}).status, 401);
   const HttpResponse modules = http(port_, HttpRequest{"GET", "/api/modules", kViewer});
   EXPECT_REPLY(modules, 200);
-  EXPECT_GT(body_of(modules)["modules"].size(), 10U);
+  const auto library = body_of(modules);  // a named copy: a range-for over a temporary's member dangles
+  EXPECT_GT(library["modules"].size(), 10U);
   // The join connector is marked as one (Onika draws it as the paper's Figure 3 does); nothing else is.
-  for (const auto& m : body_of(modules)["modules"])
+  for (const auto& m : library["modules"])
     EXPECT_EQ(m["connector"], m["name"] == "join_weighted_average" ? "join" : "") << m["name"];
   const HttpResponse model = http(port_, HttpRequest{"GET", "/api/subsystem", kViewer});
   EXPECT_REPLY(model, 200);
