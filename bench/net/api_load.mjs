@@ -6,6 +6,13 @@
 // With BATCH_HZ the clients subscribe as Onika does (batch_hz: the samples in that many frames a
 // second); `samples` counts the samples received either way, `frames` the frames.
 //   node --experimental-websocket bench/net/api_load.mjs roundtrip URL TOKEN COUNT [keepalive]
+//   node --experimental-websocket bench/net/api_load.mjs windows URL TOKEN CLIENTS RATE_HZ WINDOW_S PAIRS VAR,... BATCH_HZ TASK,...
+//
+// `windows` compares in one run: PAIRS pairs of windows of WINDOW_S seconds, one quiet, one with
+// CLIENTS streaming, in the order quiet-streaming, streaming-quiet, ... (so that a drift of the
+// machine's noise during the run weighs on both alike). Around each window it takes the `stats`
+// reply, and reports per window the TASKs' cycles, misses and release latency histogram counted
+// within it (the difference of the two replies' cumulative figures).
 //
 // URL is http://127.0.0.1:PORT/. Prints one JSON object on stdout.
 
@@ -19,7 +26,8 @@ function percentile(sorted, p) {
   return sorted[Math.min(sorted.length - 1, Math.floor(p * (sorted.length - 1)))];
 }
 
-async function stream(clients, rateHz, seconds, variables, batchHz) {
+// Opens the clients and subscribes them; resolves once each is accepted or refused (5 s).
+async function openClients(clients, rateHz, variables, batchHz) {
   const sockets = [];
   const counts = [];
   const frameCounts = [];
@@ -58,26 +66,41 @@ async function stream(clients, rateHz, seconds, variables, batchHz) {
     };
   }
   await Promise.all(opened);
-  refused = clients - accepted;
+  return { sockets, counts, frameCounts, accepted, refused: clients - accepted };
+}
+
+const sleep = (seconds) => new Promise((r) => setTimeout(r, seconds * 1000));
+const sum = (list) => list.reduce((a, b) => a + b, 0);
+
+// Counts what the open clients receive while `during` runs (after they were accepted).
+async function measureClients(open, clients, rateHz, variables, batchHz, during) {
   const start = performance.now();
-  const sum = (list) => list.reduce((a, b) => a + b, 0);
-  const before = sum(counts);
-  const framesBefore = sum(frameCounts);
-  await new Promise((r) => setTimeout(r, seconds * 1000));
-  const samples = sum(counts) - before;
-  const frames = sum(frameCounts) - framesBefore;
+  const before = sum(open.counts);
+  const framesBefore = sum(open.frameCounts);
+  await during();
+  const samples = sum(open.counts) - before;
+  const frames = sum(open.frameCounts) - framesBefore;
   const elapsed = (performance.now() - start) / 1000;
-  for (const s of sockets) s.close();
+  const { accepted, refused } = open;
   return { clients, accepted, refused, variables: variables.length, rate_hz: rateHz, batch_hz: batchHz || 0, seconds: elapsed, samples, frames, samples_per_client_per_s: accepted ? samples / accepted / elapsed : 0, frames_per_client_per_s: accepted ? frames / accepted / elapsed : 0 };
+}
+
+async function stream(clients, rateHz, seconds, variables, batchHz) {
+  const open = await openClients(clients, rateHz, variables, batchHz);
+  const result = await measureClients(open, clients, rateHz, variables, batchHz, () => sleep(seconds));
+  for (const s of open.sockets) s.close();
+  return result;
 }
 
 // One request: on a new connection each (agent false), as `curl` sends it, or on one kept open
 // (a keep-alive agent), as a browser's fetch and a script's session send them.
+// Resolves to the reply's body.
 function command(url, body, agent) {
   return new Promise((resolve, reject) => {
     const req = http.request(url, { method: 'POST', agent, headers: { Authorization: `Bearer ${token}`, 'Content-Type': 'application/json', 'Content-Length': Buffer.byteLength(body) } }, (res) => {
-      res.on('data', () => {});
-      res.on('end', () => (res.statusCode === 200 ? resolve() : reject(new Error(`HTTP ${res.statusCode}`))));
+      const chunks = [];
+      res.on('data', (chunk) => chunks.push(chunk));
+      res.on('end', () => (res.statusCode === 200 ? resolve(Buffer.concat(chunks).toString()) : reject(new Error(`HTTP ${res.statusCode}`))));
     });
     req.on('error', reject);
     req.end(body);
@@ -98,15 +121,73 @@ async function roundtrip(count, keepAlive) {
   return { count, connection: keepAlive ? 'kept alive' : 'new per request', p50_ns: percentile(times, 0.5), p99_ns: percentile(times, 0.99), max_ns: times[times.length - 1] };
 }
 
+// The tasks' cumulative figures now: cycles, missed, and the latency histogram as {bound: count}.
+async function figures(tasks) {
+  const reply = JSON.parse(await command(`${base}api/command`, '{"command": "stats"}', false));
+  const out = {};
+  for (const t of tasks) {
+    const s = reply.stats.tasks[t];
+    out[t] = { cycles: s.cycles, missed: s.missed, latency: Object.fromEntries(s.histograms.latency_ns) };
+  }
+  return out;
+}
+
+// What happened between two `figures`: per task the cycles, misses and latency histogram of the window.
+function between(before, after) {
+  const out = {};
+  for (const [t, a] of Object.entries(after)) {
+    const b = before[t];
+    const latency = [];
+    for (const [bound, count] of Object.entries(a.latency)) {
+      const n = count - (b.latency[bound] || 0);
+      if (n > 0) latency.push([Number(bound), n]);
+    }
+    latency.sort((x, y) => x[0] - y[0]);
+    out[t] = { cycles: a.cycles - b.cycles, missed: a.missed - b.missed, latency_histogram: latency };
+  }
+  return out;
+}
+
+async function windows(clients, rateHz, windowS, pairs, variables, batchHz, tasks) {
+  const settle = 0.3;  // for the clients' connections to open, or close, outside the windows
+  const quiet = async () => {
+    const before = await figures(tasks);
+    await sleep(windowS);
+    return { kind: 'none', tasks: between(before, await figures(tasks)) };
+  };
+  const streaming = async () => {
+    const open = await openClients(clients, rateHz, variables, batchHz);
+    await sleep(settle);
+    let tasksOf;
+    const got = await measureClients(open, clients, rateHz, variables, batchHz, async () => {
+      const before = await figures(tasks);
+      await sleep(windowS);
+      tasksOf = between(before, await figures(tasks));
+    });
+    for (const s of open.sockets) s.close();
+    await sleep(settle);
+    return { kind: 'clients', stream: got, tasks: tasksOf };
+  };
+  const out = [];
+  for (let i = 0; i < pairs; ++i) {
+    const order = i % 2 === 0 ? [quiet, streaming] : [streaming, quiet];
+    for (const w of order) out.push(await w());
+  }
+  return { window_s: windowS, pairs, windows: out };
+}
+
 let result;
 if (mode === 'stream') {
   const [clients, rate, seconds, vars, batch] = rest;
   result = await stream(Number(clients), Number(rate), Number(seconds), vars.split(','), Number(batch || 0));
+} else if (mode === 'windows') {
+  const [clients, rate, windowS, pairs, vars, batch, tasks] = rest;
+  result = await windows(Number(clients), Number(rate), Number(windowS), Number(pairs), vars.split(','), Number(batch), tasks.split(','));
 } else if (mode === 'roundtrip') {
   result = await roundtrip(Number(rest[0]), rest[1] === 'keepalive');
 } else {
   console.error(`api_load: unknown mode ${mode}`);
   process.exit(2);
 }
-console.log(JSON.stringify(result));
-process.exit(0);
+// Exits once the whole reply is written: a pipe takes 64 KiB at once, and exit() would cut it there.
+process.stdout.write(`${JSON.stringify(result)}\n`, () => process.exit(0));

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <initializer_list>
+#include <iterator>
 #include <optional>
 #include <system_error>
 #include <variant>
@@ -130,9 +131,10 @@ std::variant<Subscription, Refusal> parse_subscription(std::string_view text, Co
 
 using Clock = std::chrono::steady_clock;
 
-// One deadline per part of a subscription; each stays on its own grid. A client that took
-// longer, or a thread woken late, skips the grid points it missed rather than getting them in a
-// burst, so two frames of a part are never closer than its grid allows after the first.
+// One deadline per part of a subscription; each stays on its own grid. A thread woken late (or a
+// client that took longer) skips the grid points it missed by the time it woke, rather than
+// getting them in a burst; the time it then spends on the frame does not count as missed (a
+// batch of 1 kHz samples takes a while to format: judged after it, a sample in 30 was lost).
 struct Part {
   std::int64_t period_ns = 0;  // 0: not asked for
   Clock::time_point next;
@@ -220,28 +222,53 @@ std::string ApiStream::sample(const std::vector<std::string>& variables, std::ui
   return dump(json{{"kind", "sample"}, {"seq", seq}, {"t_ns", t_ns}, {"values", std::move(values)}});
 }
 
+namespace {
+
+// A sample's value in JSON: an array of the values (a non-finite one as null, as nlohmann's
+// dump writes it), or null for a variable not written yet.
+void append_value(std::string& out, const Result<std::vector<double>>& value) {
+  if (!value) {
+    out += "null";
+    return;
+  }
+  out += '[';
+  for (std::size_t i = 0; i < value->size(); ++i) {
+    if (i != 0) out += ',';
+    const double x = (*value)[i];
+    if (std::isfinite(x))
+      fmt::format_to(std::back_inserter(out), "{}", x);  // the shortest text that reads back as x
+    else
+      out += "null";
+  }
+  out += ']';
+}
+
+}  // namespace
+
 void ApiStream::add_to_batch(Batch& batch, const std::vector<std::string>& variables, std::uint64_t seq,
                              std::int64_t t_ns) const {
   if (batch.count == 0) {
     batch.first_seq = seq;
-    batch.t_ns = json::array();
-    batch.values = json::object();
-    for (const auto& v : variables) batch.values[v] = json::array();
+    batch.t_ns.clear();
+    batch.values.resize(variables.size());
+    for (auto& v : batch.values) v.clear();
   }
-  batch.t_ns.push_back(t_ns);
-  for (const auto& v : variables) {
-    auto value = gate_.sample(v);
-    batch.values[v].push_back(value ? json(*value) : json(nullptr));  // not written yet: null
+  const char* comma = batch.count == 0 ? "" : ",";
+  fmt::format_to(std::back_inserter(batch.t_ns), "{}{}", comma, t_ns);
+  for (std::size_t i = 0; i < variables.size(); ++i) {
+    batch.values[i] += comma;
+    append_value(batch.values[i], gate_.sample(variables[i]));
   }
   ++batch.count;
 }
 
-std::string ApiStream::take_batch(Batch& batch) {
-  std::string text = dump(json{{"kind", "samples"},
-                               {"seq", batch.first_seq},
-                               {"count", batch.count},
-                               {"t_ns", std::move(batch.t_ns)},
-                               {"values", std::move(batch.values)}});
+std::string ApiStream::take_batch(Batch& batch, const std::vector<std::string>& variables) {
+  std::string text = fmt::format(R"({{"kind": "samples", "seq": {}, "count": {}, "t_ns": [{}], "values": {{)",
+                                 batch.first_seq, batch.count, batch.t_ns);
+  for (std::size_t i = 0; i < variables.size() && i < batch.values.size(); ++i)
+    fmt::format_to(std::back_inserter(text), "{}{}: [{}]", i == 0 ? "" : ", ", json(variables[i]).dump(),
+                   batch.values[i]);
+  text += "}}";
   batch.count = 0;
   return text;
 }
@@ -328,12 +355,12 @@ void ApiStream::run() {
         ok = send(sample(wanted.variables, samples.seq++, t_ns));
       } else {
         add_to_batch(batch, wanted.variables, samples.seq++, t_ns);
-        if (batch.count >= kMaxBatchSamples) ok = send(take_batch(batch));
+        if (batch.count >= kMaxBatchSamples) ok = send(take_batch(batch, wanted.variables));
       }
-      samples.advance(Clock::now());
+      samples.advance(now);  // the grid points missed by the wake, not by the frame's work
     }
     if (ok && batches.due(now)) {
-      if (batch.count > 0) ok = send(take_batch(batch));
+      if (batch.count > 0) ok = send(take_batch(batch, wanted.variables));
       batches.advance(Clock::now());
     }
     if (ok && timings.due(now)) {
