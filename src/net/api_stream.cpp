@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cmath>
 #include <initializer_list>
 #include <iterator>
 #include <optional>
@@ -15,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "chimera/control/stats_json.hpp"
+#include "sample_text.hpp"
 
 namespace chimera::net {
 
@@ -222,29 +222,6 @@ std::string ApiStream::sample(const std::vector<std::string>& variables, std::ui
   return dump(json{{"kind", "sample"}, {"seq", seq}, {"t_ns", t_ns}, {"values", std::move(values)}});
 }
 
-namespace {
-
-// A sample's value in JSON: an array of the values (a non-finite one as null, as nlohmann's
-// dump writes it), or null for a variable not written yet.
-void append_value(std::string& out, const Result<std::vector<double>>& value) {
-  if (!value) {
-    out += "null";
-    return;
-  }
-  out += '[';
-  for (std::size_t i = 0; i < value->size(); ++i) {
-    if (i != 0) out += ',';
-    const double x = (*value)[i];
-    if (std::isfinite(x))
-      fmt::format_to(std::back_inserter(out), "{}", x);  // the shortest text that reads back as x
-    else
-      out += "null";
-  }
-  out += ']';
-}
-
-}  // namespace
-
 void ApiStream::add_to_batch(Batch& batch, const std::vector<std::string>& variables, std::uint64_t seq,
                              std::int64_t t_ns) const {
   if (batch.count == 0) {
@@ -257,7 +234,7 @@ void ApiStream::add_to_batch(Batch& batch, const std::vector<std::string>& varia
   fmt::format_to(std::back_inserter(batch.t_ns), "{}{}", comma, t_ns);
   for (std::size_t i = 0; i < variables.size(); ++i) {
     batch.values[i] += comma;
-    append_value(batch.values[i], gate_.sample(variables[i]));
+    append_sample_value(batch.values[i], gate_.sample(variables[i]));
   }
   ++batch.count;
 }
