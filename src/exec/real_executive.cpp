@@ -221,13 +221,16 @@ void RealExecutive::form_threads() {
     if (t == nullptr) {
       threads_.push_back(std::make_unique<TaskThread>());
       t = threads_.back().get();
+      t->number = static_cast<int>(threads_.size());
       t->cpu = w.cpu;
       t->priority = w.fixed_priority;
       if (groups) shared[key] = t;
     }
     t->members.push_back(&w);
     w.thread = t;
-    w.group = static_cast<int>(threads_.size());  // the thread's number, from 1: it stays when a watch moves it
+    // The number of the thread it joins, not of the last one made: a thread made between two of
+    // its members (another CPU's, another process's task) must not lend the later ones its number.
+    w.group = t->number;  // it stays when a watch moves it
   }
 }
 

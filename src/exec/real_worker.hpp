@@ -33,6 +33,7 @@ struct Worker;
 /// One thread and the tasks it runs (in data-flow order).
 struct TaskThread {
   std::vector<Worker*> members;
+  int number = 0;  // from 1, in the order the threads were made: its members' `group`
   int cpu = 0;
   int priority = 1;
   pthread_t handle{};    // the control thread's: for join

@@ -375,16 +375,12 @@ TEST(ModuleProcessTriggers, AnAperiodicTaskIsWokenByAProducerInAnotherProcess) {
 // run the next (a miss of the consumer's). So mismatches never exceed those counts; without the
 // rule across processes nearly every release of a consumer that runs first would read the
 // release before.
-TEST(ModuleProcessPrecedence, AConsumerReadsItsProducersValueOfTheSameReleaseAcrossProcesses) {
+// Runs `tasks` (a file's task list with a `stamp` producer and a `check` consumer) until check
+// ran 300 releases, and checks the same-rate rule held between them as explained above.
+void expect_same_release_stamps(const std::string& name, const std::string& tasks) {
   TempDir dir;
-  const std::string path = dir.file("same_rate.yaml");
-  test::write_text(path,
-                   "subsystem: same_rate\n"
-                   "plugins: [" FAULTY_PLUGIN
-                   "]\n"
-                   "tasks:\n"
-                   "  - {name: stamp, module: release_stamp, period: 5ms, criticality: soft, process: side}\n"
-                   "  - {name: check, module: checks_stamp, period: 5ms, criticality: soft}\n");
+  const std::string path = dir.file(name + ".yaml");
+  test::write_text(path, "subsystem: " + name + "\nplugins: [" FAULTY_PLUGIN "]\ntasks:\n" + tasks);
   const auto started = test::started_subsystem(path);
   ASSERT_NE(started, nullptr);
   Subsystem& s = *started;
@@ -403,6 +399,37 @@ TEST(ModuleProcessPrecedence, AConsumerReadsItsProducersValueOfTheSameReleaseAcr
       << " deadlines and the producer " << stamp.missed << " (" << stamp.skipped << " skipped)";
   EXPECT_LT(check.order_timeouts, check.cycles / 2) << "the rule gave up on most releases";
   EXPECT_LT(explained, static_cast<double>(check.cycles) / 2) << "too loaded a machine to tell";
+}
+
+TEST(ModuleProcessPrecedence, AConsumerReadsItsProducersValueOfTheSameReleaseAcrossProcesses) {
+  expect_same_release_stamps("same_rate",
+                             "  - {name: stamp, module: release_stamp, period: 5ms, criticality: soft, process: side}\n"
+                             "  - {name: check, module: checks_stamp, period: 5ms, criticality: soft}\n");
+}
+
+// Figure 4 with the PID in its own process has this shape: the consumer shares a thread with a
+// task placed before the producer (traj, pid, robot), so the producer's thread was made between
+// the two. The consumer once took the number of that thread for its own, believed the producer
+// ran on its thread and had had its turn, and never waited: every release read the one before,
+// each counted as an order timeout.
+TEST(ModuleProcessPrecedence, AConsumerWaitsForAProducerOfAnotherProcessPlacedBetweenItsThreadMates) {
+  expect_same_release_stamps(
+      "same_rate_between",
+      "  - {name: head, module: release_stamp, period: 5ms, criticality: soft, cpu: 0, rename: {stamp: head_stamp}}\n"
+      "  - {name: stamp, module: release_stamp, period: 5ms, criticality: soft, cpu: 0, process: side}\n"
+      "  - {name: check, module: checks_stamp, period: 5ms, criticality: soft, cpu: 0}\n");
+}
+
+// The same shape in one process: the producer's thread is made between the consumer's thread-mates
+// because it runs on the other CPU (the machines this runs on have two), after a task that takes
+// 300 us, so that a consumer that does not wait reads the release before.
+TEST(ModuleProcessPrecedence, AConsumerWaitsForAProducerOfAnotherCpuPlacedBetweenItsThreadMates) {
+  expect_same_release_stamps(
+      "same_rate_other_cpu",
+      "  - {name: head, module: release_stamp, period: 5ms, criticality: soft, cpu: 0, rename: {stamp: head_stamp}}\n"
+      "  - {name: slow, module: cpu_load, period: 5ms, criticality: soft, cpu: 1, params: {exec: 0.0003}}\n"
+      "  - {name: stamp, module: release_stamp, period: 5ms, criticality: soft, cpu: 1}\n"
+      "  - {name: check, module: checks_stamp, period: 5ms, criticality: soft, cpu: 0}\n");
 }
 
 // A stray pointer in a module process writes only where its own tasks write: the table's other
