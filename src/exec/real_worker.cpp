@@ -205,7 +205,7 @@ std::int64_t Worker::prepare() {
   if (schedule.on_at >= 0) return exec->epoch_ns() + schedule.on_at * task->period_ns();  // a switch: on then
   if (task->state() != TaskState::kOn) {
     precedence->scheduled.store(-1, std::memory_order_release);  // release: successors stop waiting on us
-    return kNever;
+    return schedule.leave_seq != 0 ? 0 : kNever;  // failed while a switch's leave waited: answer it now
   }
   if (schedule.held) return kNever;  // waiting for kJoin; `scheduled` is the control thread's until then
   const std::int64_t release_abs = exec->epoch_ns() + schedule.k * task->period_ns();
@@ -218,6 +218,12 @@ void Worker::act() {
   // A switch's joining task turns on and runs its first release at once: a consumer that shares
   // its thread comes after it in the same pass and must find that release done.
   if (schedule.on_at >= 0) join_now();
+  // A task that left ON (a failed cycle: ERROR) between a switch's leave and its commit has left:
+  // it answers now, or the switch would wait for a release it no longer runs.
+  if (schedule.leave_seq != 0 && task->state() != TaskState::kOn) {
+    leave();
+    return;
+  }
   if (task->state() != TaskState::kOn || schedule.held) return;
   const std::int64_t period = task->period_ns();
   const std::int64_t epoch = exec->epoch_ns();
