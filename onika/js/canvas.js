@@ -38,30 +38,49 @@ export function linksOf(tasks) {
   return { links, unproduced, producers };
 }
 
-/** Columns from the data flow: a task one column right of what it reads, loops cut where met. */
+/**
+ * Columns from the data flow: a task one column right of what it reads, loops cut. The tasks are
+ * ordered as in Eades, Lin and Smyth's greedy heuristic (1993): sinks to the end, sources to the
+ * front, and when neither is left the first task of the file (where they choose the one that
+ * feeds the most more than it is fed: files list their tasks in data-flow order, and the file's
+ * choice reads as the paper's figures do). A link against that order closes a loop and does not
+ * place a task. So a loop with no source (Figure 3's cameras read the pose the arm's kinematics
+ * measure) is cut where the file begins it, and both cameras stand in the first column; a depth-
+ * first walk from the first camera went round the loop and put the second one last.
+ */
 export function layers(tasks, links) {
   const index = new Map(tasks.map((t, i) => [t.name, i]));
-  const next = tasks.map(() => []);
+  const next = tasks.map(() => new Set());
+  const prev = tasks.map(() => new Set());
   // Constants (ndof) size ports but carry no data flow: they do not place a task.
-  for (const l of links) if (l.from !== l.to && l.in.kind !== 'in-const') next[index.get(l.from.name)].push(index.get(l.to.name));
-  const mark = tasks.map(() => 0); // 0 new, 1 on the path, 2 done
-  const forward = tasks.map(() => []);
-  const visit = (u) => {
-    mark[u] = 1;
-    for (const v of next[u]) {
-      if (mark[v] === 1) continue; // a back edge: the loop is closed by it, not laid out by it
-      if (!forward[u].includes(v)) forward[u].push(v);
-      if (mark[v] === 0) visit(v);
+  for (const l of links)
+    if (l.from !== l.to && l.in.kind !== 'in-const') {
+      const u = index.get(l.from.name);
+      const v = index.get(l.to.name);
+      next[u].add(v);
+      prev[v].add(u);
     }
-    mark[u] = 2;
-  };
-  // Sources first (tasks nothing in the configuration feeds), then the rest in file order.
-  const fed = new Set(links.filter((l) => l.from !== l.to && l.in.kind !== 'in-const').map((l) => l.to.name));
-  tasks.forEach((t, i) => !fed.has(t.name) && mark[i] === 0 && visit(i));
-  tasks.forEach((t, i) => mark[i] === 0 && visit(i));
+  const left = new Set(tasks.map((t, i) => i));
+  const count = (set) => [...set].filter((x) => left.has(x)).length;
+  const front = [];
+  const back = [];
+  const first = (wanted) => [...left].sort((a, b) => a - b).find(wanted);
+  while (left.size > 0) {
+    let u = first((x) => count(next[x]) === 0 && count(prev[x]) > 0);
+    if (u !== undefined) {
+      back.unshift(u);
+    } else {
+      u = first((x) => count(prev[x]) === 0);
+      if (u === undefined) u = first(() => true);
+      front.push(u);
+    }
+    left.delete(u);
+  }
+  const order = front.concat(back);
+  const position = tasks.map(() => 0);
+  order.forEach((u, p) => (position[u] = p));
   const column = tasks.map(() => 0);
-  for (let round = 0; round < tasks.length; ++round)
-    forward.forEach((vs, u) => vs.forEach((v) => (column[v] = Math.max(column[v], column[u] + 1))));
+  for (const u of order) for (const v of next[u]) if (position[v] > position[u]) column[v] = Math.max(column[v], column[u] + 1);
   return column;
 }
 

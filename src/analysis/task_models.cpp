@@ -1,7 +1,9 @@
 #include "chimera/analysis/task_models.hpp"
 
 #include <algorithm>
+#include <map>
 #include <string_view>
+#include <utility>
 
 namespace chimera::analysis {
 namespace {
@@ -30,6 +32,14 @@ std::vector<TaskModel> task_models(const SubsystemSpec& spec, std::span<const st
   std::vector<std::string_view> named(task_names.begin(), task_names.end());
   std::sort(named.begin(), named.end());
   const auto is_named = [&](const std::string& name) { return std::binary_search(named.begin(), named.end(), name); };
+  // A same-rate chain is kept on one CPU so that its hand-overs cost nothing; across module
+  // processes a hand-over on one CPU costs two context switches every release, and on two CPUs
+  // only the producer's job (the consumer spins for a producer that is running it): so each
+  // process's part of a chain is a chain of its own, named by its first task in the file.
+  std::map<std::pair<int, std::string_view>, int> chain_part;  // (chain, process) -> its first task
+  if (order != nullptr)
+    for (std::size_t i = 0; i < spec.tasks.size() && i < order->chain.size(); ++i)
+      chain_part.emplace(std::pair<int, std::string_view>{order->chain[i], spec.tasks[i].process}, static_cast<int>(i));
   std::vector<TaskModel> models;
   for (std::size_t i = 0; i < spec.tasks.size(); ++i) {
     const TaskSpec& t = spec.tasks[i];
@@ -55,7 +65,7 @@ std::vector<TaskModel> task_models(const SubsystemSpec& spec, std::span<const st
       m.period_ns = t.server->period_ns;
     }
     if (order != nullptr && i < order->chain.size()) {
-      m.chain = order->chain[i];
+      m.chain = chain_part.at({order->chain[i], t.process});
       for (const int p : order->predecessors[i])
         if (is_named(spec.tasks[static_cast<std::size_t>(p)].name)) m.same_rate_producers.push_back(p);
     }

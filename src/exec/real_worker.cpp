@@ -18,7 +18,7 @@
 namespace chimera {
 
 namespace {
-// How long a late consumer spins for a producer on another CPU before it sleeps (see
+// How long a consumer spins for a producer on another CPU before it sleeps (see
 // wait_for_predecessors): a few cross-CPU wake-ups' worth on this kind of machine.
 constexpr std::int64_t kCatchUpSpinNs = 50'000;
 
@@ -306,10 +306,10 @@ void Worker::wait_for_predecessors(std::int64_t release, std::int64_t release_ab
   const std::int64_t give_up =
       release_policy::producer_wait_until(release_abs, monotonic_ns(), task->spec().deadline_ns);
   bool behind = false;  // a producer had an earlier release still to run: not waited for
-  // A late job (a period or more behind its release) spins briefly for a producer on another CPU
-  // before it sleeps; an on-time one sleeps at once (a spin would cost CPU every period).
-  const std::int64_t now = monotonic_ns();
-  const std::int64_t spin_until = now - release_abs >= task->period_ns() ? now + kCatchUpSpinNs : 0;
+  // A job spins briefly for a producer on another CPU before it sleeps: the producer, due for the
+  // same release, is running it or about to, and a futex sleep and cross-CPU wake-up would cost
+  // more than its job (tens of microseconds on a VM, on the chain's path every release).
+  const std::int64_t spin_until = monotonic_ns() + kCatchUpSpinNs;
   for (Worker* p : predecessors) {
     for (;;) {
       // acquire: its cycle's outputs are published
@@ -335,9 +335,9 @@ void Worker::wait_for_predecessors(std::int64_t release, std::int64_t release_ab
         behind = behind || release_policy::producer_behind(on, completed, completed_previous, next, release);
         break;
       }
-      if (spin_until > 0 && p->cpu != cpu) {
-        // Catching up: the producer, on another CPU, is running the releases just before ours
-        // one after another; a futex sleep and wake per release would cost more than the job.
+      if (p->cpu != cpu) {
+        // Also when catching up: the producer is running the releases just before ours one
+        // after another, and a sleep and wake per release would cost more than the job.
         while (!reached(p->precedence->completed.load(std::memory_order_acquire), release) &&  // acquire: as above
                monotonic_ns() < spin_until) {
           cpu_relax();

@@ -404,6 +404,11 @@ test("Figure 3's join connector: drawn as a funnel, its two producers' links con
     // Only the join is drawn so: the cameras and the rest are boxes.
     assert.deepEqual(await page.$$eval('#canvas g.task.join', (gs) => gs.map((g) => g.dataset.task)), ['join']);
     assert.ok(await page.$('#canvas g.task[data-task="camera_a"] rect.task-box'), 'a camera is a box');
+    // Every task is fed (the cameras read the measured pose): the loop is cut where the file
+    // begins it, and the two cameras stand in the first column, left of the join they feed.
+    const [cameraA, cameraB, joinBox] = [await boxOf(page, 'camera_a'), await boxOf(page, 'camera_b'), await boxOf(page, 'join')];
+    assert.equal(cameraA.x, cameraB.x, `both cameras in one column: ${JSON.stringify([cameraA, cameraB])}`);
+    assert.ok(cameraA.x < joinBox.x && cameraA.y !== cameraB.y, `the cameras left of the join: ${JSON.stringify([cameraA, cameraB, joinBox])}`);
     const into = await page.$$eval('#canvas path.link[data-to="join"]', (ps) => ps.map((p) => `${p.dataset.from}:${p.dataset.variable}`).sort());
     assert.deepEqual(into, ['camera_a:x_d_a', 'camera_b:x_d_b']);
     // Its one output leaves from the funnel's point.

@@ -44,9 +44,9 @@ struct TaskModel {
   /// Position in the file: the last tie-break everywhere.
   int file_index = 0;
   WcetSource wcet_source = WcetSource::kUnknown;
-  /// The task's same-rate chain (analysis/release_order.hpp): tasks of one chain have the same
-  /// value, the file index of its first task. -1: a chain of its own. CPU assignment keeps a
-  /// chain on one CPU where it fits.
+  /// The task's same-rate chain (analysis/release_order.hpp) within its process: tasks of one
+  /// chain and one process have the same value, the file index of the first of them. -1: a chain
+  /// of its own. CPU assignment keeps a chain on one CPU where it fits.
   int chain = -1;
   /// The file indices of the same-period tasks whose job of the same release this task waits for
   /// before it starts (the same-rate rule). On another CPU, that wait is the task's release jitter.

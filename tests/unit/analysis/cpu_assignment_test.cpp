@@ -111,6 +111,31 @@ TEST(AssignSubsystemCpus, EveryTaskOfTheFileFromItsWcetAndCpu) {
   EXPECT_EQ(assign_subsystem_cpus(spec, order, cpus), (std::vector<int>{0, 1, 0}));
 }
 
+// Figure 4 with the PID in a module process of its own, C unknown: the loop traj -> pid -> robot
+// (and the monitor fed by it) is one chain, placed as one part per process. On one CPU each
+// hand-over between processes costs two context switches a release; across CPUs the consumer
+// spins for a producer running the release. The main process's part on CPU 0, the PID on CPU 1.
+TEST(AssignSubsystemCpus, AChainAcrossProcessesIsPlacedAsOnePartPerProcess) {
+  SubsystemSpec spec;
+  spec.scheduler = SchedulerKind::kRm;
+  for (const char* name : {"traj", "pid", "robot", "monitor"}) {
+    TaskSpec t;
+    t.name = name;
+    t.period_ns = 1'000'000;
+    spec.tasks.push_back(t);
+  }
+  const std::vector<int> cpus{0, 1};
+  const ReleaseOrder order{.rank = {0, 1, 2, 3}, .predecessors = {{}, {0}, {1}, {0, 2}}, .chain = {0, 0, 0, 0}};
+  EXPECT_EQ(assign_subsystem_cpus(spec, order, cpus), (std::vector<int>{0, 0, 0, 0})) << "all in one: one CPU";
+  spec.tasks[1].process = "control";
+  EXPECT_EQ(assign_subsystem_cpus(spec, order, cpus), (std::vector<int>{0, 1, 0, 0}));
+  // Two parts in one module process stay together: robot and monitor apart from traj and pid.
+  spec.tasks[1].process = kMainProcess;
+  spec.tasks[2].process = "arm";
+  spec.tasks[3].process = "arm";
+  EXPECT_EQ(assign_subsystem_cpus(spec, order, cpus), (std::vector<int>{0, 0, 1, 1}));
+}
+
 // The chain: Figure 4 with a filter and a limiter in its loop, traj -> filter -> pid ->
 // limit -> robot, all at 1 ms, C unknown. Spread task by task they went 0/1/0/1/0, and every
 // consumer waited for its producer on the other CPU at every release.
