@@ -5,10 +5,6 @@
 
 #include "chimera/dds/remote_ports.hpp"
 
-#include <poll.h>
-#include <sys/eventfd.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -126,7 +122,9 @@ struct RemotePorts::Impl {
   dds_entity_t publications = 0;
 
   std::atomic<bool> stopping{false};
-  int stop_fd = -1;  // an eventfd: the destructor ends the publisher's sleep with it
+  // What the publisher sleeps on: the producers' watch (options.exports_written) or its own; the
+  // destructor ends the sleep through it.
+  std::shared_ptr<WriteWatch> watch;
   std::thread publisher;
   std::thread taker;
 
@@ -183,14 +181,10 @@ void RemotePorts::Impl::publish(ExportPort& port) {
 // Sleeps until a producer publishes an export (the watch), the destructor's word, or the poll's
 // time, whichever comes first; then publishes every export whose version moved.
 void RemotePorts::Impl::publish_loop() {
-  WriteWatch* const watch = options.exports_written.get();
-  const timespec poll{static_cast<time_t>(options.poll_ns / 1'000'000'000),
-                      static_cast<long>(options.poll_ns % 1'000'000'000)};
   while (!stopping.load(std::memory_order_relaxed)) {  // relaxed: the flag carries no data
-    if (watch != nullptr) (void)watch->take();         // before the reads: news after it wakes us again
+    (void)watch->take();                               // before the reads: news after it wakes us again
     for (auto& port : exports) publish(port);
-    std::array<pollfd, 2> fds{pollfd{stop_fd, POLLIN, 0}, pollfd{watch != nullptr ? watch->fd() : -1, POLLIN, 0}};
-    (void)::ppoll(fds.data(), fds.size(), &poll, nullptr);
+    watch->wait_until(monotonic_ns() + options.poll_ns);
   }
 }
 
@@ -223,24 +217,28 @@ Result<void> RemotePorts::Impl::listen_to_imports() {
 }
 
 void RemotePorts::Impl::take_sample(ImportPort& port, const Msg& msg, const dds_sample_info_t& info) {
-  const std::optional<SampleStamp> stamp = stamp_of(msg);
   const std::uint32_t offset = msg.layout.data_offset;
   const std::uint32_t length = msg.data._length >= offset ? msg.data._length - offset : 0;
-  const std::string writer = stamp ? stamp->writer : std::string();
-  const std::string who =
-      stamp ? fmt::format("subsystem {}", writer) : std::string("a writer without a Chimera stamp (a ROS 2 node?)");
+  // The value first, its bookkeeping after: a reader of the table waits for nothing else.
+  if (length == port.spec.count) {
+    table.write(port.index, msg.data._buffer + offset);
+    port.last_update_ns.store(monotonic_ns(), std::memory_order_relaxed);  // relaxed: see its declaration
+  }
+  std::optional<SampleStamp> stamp = stamp_of(msg);
+  const auto who = [&] {
+    return stamp ? fmt::format("subsystem {}", stamp->writer)
+                 : std::string("a writer without a Chimera stamp (a ROS 2 node?)");
+  };
   if (length != port.spec.count) {
-    refuse_shape(port, stamp ? who : fmt::format("{}, instance {:x}", who, info.publication_handle), length);
+    refuse_shape(port, stamp ? who() : fmt::format("{}, instance {:x}", who(), info.publication_handle), length);
     std::lock_guard guard(status_mutex);
     ++port.status.refused;
     return;
   }
-  table.write(port.index, msg.data._buffer + offset);
-  port.last_update_ns.store(monotonic_ns(), std::memory_order_relaxed);  // relaxed: see its declaration
   std::lock_guard guard(status_mutex);
   if (++port.status.samples == 1)
-    changes.push_back(fmt::format("import {}: first sample, from {}", port.spec.variable, who));
-  port.status.writer = writer;
+    changes.push_back(fmt::format("import {}: first sample, from {}", port.spec.variable, who()));
+  port.status.writer = stamp ? std::move(stamp->writer) : std::string();
   port.status.writer_sequence = stamp ? stamp->sequence : 0;
   port.status.writer_time_ns = stamp ? stamp->time_ns : info.source_timestamp;
 }
@@ -443,15 +441,14 @@ void RemotePorts::Impl::refuse(ImportPort& port, const std::string& key, std::st
 RemotePorts::RemotePorts(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 
 RemotePorts::~RemotePorts() {
-  impl_->stopping.store(true, std::memory_order_relaxed);             // relaxed: the joins below order the rest
-  if (impl_->stop_fd >= 0) (void)::eventfd_write(impl_->stop_fd, 1);  // stays readable: the publisher cannot miss it
+  impl_->stopping.store(true, std::memory_order_relaxed);  // relaxed: the joins below order the rest
+  if (impl_->watch) impl_->watch->written();               // stays taken until the publisher looks: it cannot miss it
   if (impl_->wake > 0) dds_set_guardcondition(impl_->wake, true);
   if (impl_->publisher.joinable()) impl_->publisher.join();
   if (impl_->taker.joinable()) impl_->taker.join();
   // The participant first (it waits for a listener still running), then the ports it writes to.
   if (impl_->participant.id > 0) dds_delete(impl_->participant.id);
   impl_->participant.id = 0;
-  if (impl_->stop_fd >= 0) ::close(impl_->stop_fd);
 }
 
 namespace {
@@ -573,8 +570,7 @@ Result<std::unique_ptr<RemotePorts>> RemotePorts::create(const SubsystemSpec& sp
   // hold_when_stale) before the caller lets a task read an import that has no value yet.
   m.judge_staleness();
 
-  m.stop_fd = ::eventfd(0, EFD_CLOEXEC);
-  if (m.stop_fd < 0) return make_error(Errc::kSystem, "the bridge's publisher: no eventfd");
+  m.watch = m.options.exports_written ? m.options.exports_written : std::make_shared<WriteWatch>();
   if (!m.exports.empty()) m.publisher = std::thread([&m] { m.publish_loop(); });
   m.taker = std::thread([&m] { m.take_loop(); });  // also the exports' echoes
   // Last: nothing below may fail, since the listeners run from here on until the participant goes.

@@ -1,30 +1,28 @@
 #include "chimera/exec/write_watch.hpp"
 
-#include <sys/eventfd.h>
-#include <unistd.h>
+#include "futex.hpp"
 
 namespace chimera {
 
-WriteWatch::WriteWatch() : fd_(::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC)) {}
-
-WriteWatch::~WriteWatch() {
-  if (fd_ >= 0) ::close(fd_);
-}
-
 void WriteWatch::written() noexcept {
-  // acq_rel: pairs with take(); the flag guards only the eventfd write, the values have their own protocol
-  if (pending_.exchange(true, std::memory_order_acq_rel)) return;
-  if (fd_ >= 0) (void)::eventfd_write(fd_, 1);
+  // acq_rel: the release publishes the values before the news to take(); the acquire sees the
+  // watcher's kSleeping, so that a sleeping watcher is always woken.
+  const std::uint32_t before = word_.fetch_or(kNews, std::memory_order_acq_rel);
+  if ((before & kNews) == 0 && (before & kSleeping) != 0) detail::futex_wake_all(word_);
 }
 
 bool WriteWatch::take() noexcept {
-  // The eventfd first, then the flag: a written() between the two finds the flag still up and
-  // writes nothing, but its value was published before it, so the reads after this return see it.
-  if (fd_ >= 0) {
-    eventfd_t drained = 0;
-    (void)::eventfd_read(fd_, &drained);
-  }
-  return pending_.exchange(false, std::memory_order_acq_rel);  // acq_rel: pairs with written()
+  return (word_.fetch_and(~kNews, std::memory_order_acq_rel) & kNews) != 0;  // acq_rel: pairs with written()
+}
+
+void WriteWatch::wait_until(std::int64_t deadline_ns) noexcept {
+  // acq_rel: kSleeping is seen by every written() after it, and news before it is seen here. A
+  // written() between this and the futex's sleep changes the word, and the futex does not sleep.
+  const std::uint32_t before = word_.fetch_or(kSleeping, std::memory_order_acq_rel);
+  if ((before & kNews) == 0) (void)detail::futex_wait(word_, kSleeping, deadline_ns);
+  // acquire: what the waker wrote before its news (a stop flag) is seen after the wake. A
+  // written() that still finds kSleeping set makes one needless wake, nothing worse.
+  word_.fetch_and(~kSleeping, std::memory_order_acquire);
 }
 
 }  // namespace chimera
