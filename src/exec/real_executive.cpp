@@ -22,6 +22,7 @@
 #include "chimera/core/invariant.hpp"
 #include "chimera/exec/clock.hpp"
 #include "chimera/exec/write_watch.hpp"
+#include "cpu_wake_latency.hpp"
 #include "futex.hpp"
 #include "priority_dispatcher.hpp"
 #include "real_worker.hpp"
@@ -112,6 +113,8 @@ void prepare_realtime_process(bool realtime) {
   // flight-recorder dump's copy of a ring) gets a mapping of its own, given back when freed:
   // glibc's default threshold rises past the first such block freed, and puts the next in the heap.
   mallopt(M_MMAP_THRESHOLD, 128 * 1024);
+  // Silent when refused: it needs root, as SCHED_FIFO does, whose refusal is already reported.
+  (void)detail::hold_cpu_wake_latency();
 }
 
 RealExecutive::RealExecutive(ExecutiveSetup setup)
