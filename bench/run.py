@@ -11,7 +11,6 @@ Adding a benchmark is one entry here, its keys in goals.py, and its program in C
 """
 
 import argparse
-import collections
 import datetime
 import json
 import os
@@ -31,6 +30,8 @@ ROOT = HERE.parent
 sys.path.insert(0, str(HERE))
 import goals  # noqa: E402
 import dds_bridge  # noqa: E402
+import windows as win  # noqa: E402
+from windows import ServedRun  # noqa: E402
 import history  # noqa: E402
 
 
@@ -191,37 +192,6 @@ def network_yaml():
     return text, variables
 
 
-class ServedRun:
-    """chimera run FILE --listen 127.0.0.1:0 --for SECONDS --stats-json, its link read from stderr."""
-
-    def __init__(self, chimera, yaml, seconds, ctx, name):
-        self.stats = ctx.work / f"network_{name}.json"
-        self.err = open(ctx.work / f"network_{name}.stderr", "w+")
-        env = dict(os.environ, CHIMERA_LOG_DIR=str(ctx.work))
-        self.proc = subprocess.Popen([str(chimera), "run", str(yaml), "--listen", "127.0.0.1:0", "--for", f"{seconds}s",
-                                      "--stats-json", str(self.stats)], stdin=subprocess.PIPE, stdout=subprocess.DEVNULL,
-                                     stderr=self.err, env=env)
-        deadline = time.time() + 20
-        self.base = self.token = None
-        while time.time() < deadline and self.base is None:
-            time.sleep(0.1)
-            self.err.seek(0)
-            m = re.search(r"Onika, the page, on (http://\S+/)#token=(\w+)", self.err.read())
-            if m:
-                self.base, self.token = m.group(1), m.group(2)
-        if self.base is None:
-            self.proc.kill()
-            raise RuntimeError(f"chimera printed no link: see {self.err.name}")
-
-    def rss_kb(self):
-        m = re.search(r"^VmRSS:\s+(\d+) kB", read(f"/proc/{self.proc.pid}/status"), re.M)
-        return int(m.group(1)) if m else 0
-
-    def finish(self, timeout_s):
-        self.proc.wait(timeout=timeout_s)
-        return json.loads(self.stats.read_text())
-
-
 # What Onika asks for (onika/js/main.js): the samples in this many frames a second.
 ONIKA_BATCH_HZ = 30
 
@@ -237,17 +207,9 @@ def run_network_api(build, ctx):
     yaml.write_text(text)
     fig4_tasks = ["traj", "pid", "robot"]
 
-    def p99s(stats):
-        return {t: stats["tasks"][t]["latency_ns"]["p99"] for t in fig4_tasks}
-
-    def work_done(stats):  # beside each figure: the cycles it ran and the deadlines missed
-        return {t: {"cycles": stats["tasks"][t]["cycles"], "missed": stats["tasks"][t]["missed"]} for t in fig4_tasks}
-
     # Without clients and with 10 clients streaming 20 variables at 1 kHz, in one run: windows of
     # two seconds, quiet and streaming by turns (api_load.mjs `windows`), each task's release
-    # latency histogram counted within each window. On this VM the noise moves tenfold within a
-    # minute (one run's p99 0.1 to 8 ms seen without clients), so runs one after the other compared
-    # different machines; windows a second apart meet the same one.
+    # latency histogram counted within each window (bench/windows.py says why windows).
     window_s, pairs = 2, (3 if ctx.quick else 15)
     run = ServedRun(chimera, yaml, pairs * 2 * (window_s + 2) + 10, ctx, "windows")
     cmd = load + ["windows", run.base, run.token, "10", "1000", str(window_s), str(pairs), ",".join(variables),
@@ -264,36 +226,9 @@ def run_network_api(build, ctx):
     run.proc.stdin.close()
     run.finish(pairs * 2 * (window_s + 2) + 40)
 
-    def merged(mode):  # per task: the histogram, cycles and misses of every window of the mode
-        out = {}
-        for t in fig4_tasks:
-            hist = collections.Counter()
-            cycles = missed = 0
-            for w in windows:
-                if w["kind"] != mode:
-                    continue
-                hist.update({b: n for b, n in w["tasks"][t]["latency_histogram"]})
-                cycles += w["tasks"][t]["cycles"]
-                missed += w["tasks"][t]["missed"]
-            out[t] = {"histogram": sorted(hist.items()), "cycles": cycles, "missed": missed}
-        return out
-
-    def p99(histogram):  # the upper bound of the bucket that holds the 99th percentile
-        total = sum(n for _, n in histogram)
-        seen = 0
-        for bound, n in histogram:
-            seen += n
-            if seen >= 0.99 * total:
-                return bound
-        return 0
-
-    per_mode = {m: merged(m) for m in ("none", "clients")}
-    none = {t: p99(per_mode["none"][t]["histogram"]) for t in fig4_tasks}
-    with_clients = {t: p99(per_mode["clients"][t]["histogram"]) for t in fig4_tasks}
-    work = {m: {t: {k: per_mode[m][t][k] for k in ("cycles", "missed")} for t in fig4_tasks} for m in per_mode}
+    compared = win.compare(windows, fig4_tasks, "none", "clients")
+    none, with_clients = compared["p99_ns"]["none"], compared["p99_ns"]["clients"]
     streams = [w["stream"] for w in windows if w["kind"] == "clients"]
-    per_window = [{"kind": w["kind"], "p99_ns": {t: p99(w["tasks"][t]["latency_histogram"]) for t in fig4_tasks},
-                   "missed": {t: w["tasks"][t]["missed"] for t in fig4_tasks}} for w in windows]
 
     # The command round trip, and the memory with 100 clients streaming (each a connection and a thread).
     run = ServedRun(chimera, yaml, 20, ctx, "round_trip")
@@ -318,7 +253,7 @@ def run_network_api(build, ctx):
     run.proc.stdin.close()
     run.finish(40)
 
-    ratios = {t: with_clients[t] / none[t] for t in fig4_tasks if none[t] > 0}
+    ratios = compared["ratios"]
     # Met only when the work was done: the clients got (nearly) every one of their 1,000 samples a
     # second over the streaming windows; with fewer they measured a lighter load, and the ratio is
     # not reported (it stays in the details).
@@ -327,6 +262,7 @@ def run_network_api(build, ctx):
     least = min((s["samples_per_client_per_s"] for s in streams), default=0)
     reported = ratios if delivered >= 950 and all(s["refused"] == 0 for s in streams) else {}
     results = {"api_stream_latency_p99_ratio": max(reported.values()) if reported else None,
+               "api_stream_control_p99_ratio": compared["control_worst"] if reported else None,
                "api_round_trip_ns_p50": round_trip["p50_ns"], "api_round_trip_ns_p99": round_trip["p99_ns"],
                "api_round_trip_keepalive_ns_p50": kept_alive["p50_ns"],
                "api_round_trip_keepalive_ns_p99": kept_alive["p99_ns"],
@@ -334,7 +270,8 @@ def run_network_api(build, ctx):
     details = {"window_s": window_s, "pairs": pairs, "variables": variables, "batch_hz": ONIKA_BATCH_HZ,
                "samples_per_client_per_s": delivered, "samples_per_client_per_s_least_window": least,
                "p99_ns_without_clients": none, "p99_ns_with_clients": with_clients, "ratios": ratios,
-               "cycles_and_missed": work, "windows": per_window, "streams": streams,
+               "control_ratios": compared["control_ratios"], "cycles_and_missed": compared["cycles_and_missed"],
+               "windows": compared["windows"], "streams": streams,
                "round_trip": round_trip, "round_trip_kept_alive": kept_alive, "rss_kb_idle": rss_idle, "rss_kb_100_clients": rss_held,
                "hold_100_clients": held}
     return {"results": {k: v for k, v in results.items() if v is not None}, "details": details}
@@ -372,14 +309,14 @@ PROGRAMS = [
              "process_pid_cycle_extra_ns", "process_switch_lost_cycles", "process_death_to_error_ns_p50",
              "process_death_to_error_ns_max", "process_clear_to_on_ns_p50", "process_clear_to_on_ns_max"]),
     Program("network_api", "apps/chimera/chimera", "the control API under load: 10 clients streaming, round trips, 100 clients",
-            ["api_stream_latency_p99_ratio", "api_round_trip_ns_p50", "api_round_trip_ns_p99",
+            ["api_stream_latency_p99_ratio", "api_stream_control_p99_ratio", "api_round_trip_ns_p50", "api_round_trip_ns_p99",
              "api_round_trip_keepalive_ns_p50", "api_round_trip_keepalive_ns_p99", "api_memory_100_clients_kb"],
             run=run_network_api, timeout_s=300),
     Program("dds_bridge", "dds_bridge_ipc", "the DDS bridge: table to table against raw Cyclone DDS; 100 variables "
             "streamed beside Figure 4",
             ["dds_raw_array_latency_ns_p50", "dds_raw_array_latency_ns_p99", "dds_bridge_latency_ns_p50",
              "dds_bridge_latency_ns_p99", "dds_bridge_latency_p50_ratio", "dds_bridge_latency_p99_ratio",
-             "dds_stream_latency_p99_ratio"],
+             "dds_stream_latency_p99_ratio", "dds_stream_control_p99_ratio"],
             run=lambda build, ctx: dds_bridge.run(build, ctx, run_fragment), timeout_s=600),
     Program("switch", "switch_bench", "10,000 switches at 1 kHz on the real clock",
             ["switch_lost_cycles", "switch_commit_latency_ns_p50", "switch_commit_latency_ns_p99"],
