@@ -89,8 +89,8 @@ def streaming_window(chimera, ctx, run, importer_file, variables, env, window_s,
         before = run.figures(FIG4_TASKS)
         time.sleep(window_s)
         after = run.figures(FIG4_TASKS)
+        took = time.monotonic() - ready  # to the status, which the importer answers at once
         out, _ = importer.communicate("status\nquit\n", timeout=30)
-        took = time.monotonic() - ready
     except BaseException:
         importer.kill()
         raise
