@@ -20,4 +20,13 @@ bool futex_wait(const std::atomic<std::uint32_t>& word, std::uint32_t expected, 
 /// Wakes every thread sleeping on `word`.
 void futex_wake_all(const std::atomic<std::uint32_t>& word, FutexScope scope = FutexScope::kProcess) noexcept;
 
+/// One step of a spin-wait: tells the CPU (and a hypervisor) that this thread is only waiting.
+inline void cpu_relax() noexcept {
+#if defined(__x86_64__) || defined(__i386__)
+  __builtin_ia32_pause();
+#elif defined(__aarch64__)
+  asm volatile("yield");
+#endif
+}
+
 }  // namespace chimera::detail

@@ -22,14 +22,6 @@ namespace {
 // wait_for_predecessors): a few cross-CPU wake-ups' worth on this kind of machine.
 constexpr std::int64_t kCatchUpSpinNs = 50'000;
 
-inline void cpu_relax() noexcept {
-#if defined(__x86_64__) || defined(__i386__)
-  __builtin_ia32_pause();
-#elif defined(__aarch64__)
-  asm volatile("yield");
-#endif
-}
-
 // Release indices are compared modulo 2^32 (the futex word is 32 bits).
 bool reached(std::uint32_t completed_plus_one, std::int64_t k) {
   return static_cast<std::int32_t>(completed_plus_one - static_cast<std::uint32_t>(k + 1)) >= 0;
@@ -205,7 +197,7 @@ std::int64_t Worker::prepare() {
   if (schedule.on_at >= 0) return exec->epoch_ns() + schedule.on_at * task->period_ns();  // a switch: on then
   if (task->state() != TaskState::kOn) {
     precedence->scheduled.store(-1, std::memory_order_release);  // release: successors stop waiting on us
-    return schedule.leave_seq != 0 ? 0 : kNever;  // failed while a switch's leave waited: answer it now
+    return schedule.leave_seq != 0 ? 0 : kNever;                 // failed while a switch's leave waited: answer it now
   }
   if (schedule.held) return kNever;  // waiting for kJoin; `scheduled` is the control thread's until then
   const std::int64_t release_abs = exec->epoch_ns() + schedule.k * task->period_ns();
@@ -340,7 +332,7 @@ void Worker::wait_for_predecessors(std::int64_t release, std::int64_t release_ab
         // after another, and a sleep and wake per release would cost more than the job.
         while (!reached(p->precedence->completed.load(std::memory_order_acquire), release) &&  // acquire: as above
                monotonic_ns() < spin_until) {
-          cpu_relax();
+          detail::cpu_relax();
         }
         if (reached(p->precedence->completed.load(std::memory_order_acquire), release)) continue;  // acquire: as above
       }

@@ -51,6 +51,8 @@ struct TaskThread {
 
  private:
   void run_periodic_members();
+  // How early to wake for the next release (release_policy::wake_lead): by its first member ON.
+  [[nodiscard]] std::int64_t wake_lead() const noexcept;
 };
 
 /// What the control thread asks of a task's thread.

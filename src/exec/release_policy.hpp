@@ -10,6 +10,7 @@
 //   rule
 //   a switch's        the cycle boundary a commit goes at
 //   commit
+//   the wake lead     how early a thread that waits for a producer on another CPU wakes
 // The sporadic server's budget is sporadic_server.hpp; a task's trigger variable is the Task's.
 
 #include <algorithm>
@@ -83,6 +84,21 @@ constexpr bool producer_behind(bool producer_on, bool producer_completed_it, boo
 constexpr std::int64_t producer_wait_until(std::int64_t release, std::int64_t wait_start,
                                            std::int64_t relative_deadline) noexcept {
   return std::max(release, wait_start) + relative_deadline / 2;
+}
+
+/// The longest a thread wakes before its release (see wake_lead): about the p99 of a timer's
+/// wake-up latency on the 2-CPU VMs this runs on (bench/results/latest.md, cyclictest).
+inline constexpr std::int64_t kMaxWakeLeadNs = 50'000;
+
+/// How early a thread wakes for a release whose first job waits for a same-period producer on
+/// another CPU (it then spins to the release): that job starts when both the producer's CPU and
+/// its own have woken, so each CPU's timer latency would count, the worse of the two at every
+/// release. Woken early, only the producer's does. Capped at a twentieth of the period, which
+/// is what the spin costs the thread's CPU at most; 0 for a thread that waits for nothing on
+/// another CPU (it would spin for nothing).
+constexpr std::int64_t wake_lead(bool waits_on_another_cpu, std::int64_t period) noexcept {
+  if (!waits_on_another_cpu || period <= 0) return 0;
+  return std::min(kMaxWakeLeadNs, period / 20);
 }
 
 }  // namespace chimera::release_policy

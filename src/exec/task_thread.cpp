@@ -8,6 +8,7 @@
 #include "chimera/exec/clock.hpp"
 #include "futex.hpp"
 #include "real_worker.hpp"
+#include "release_policy.hpp"
 
 namespace chimera {
 
@@ -53,9 +54,15 @@ void TaskThread::run_periodic_members() {
     if (exiting.load(std::memory_order_relaxed)) return;  // its own store, in take_mail()
     std::int64_t earliest = Worker::kNever;
     for (Worker* m : members) earliest = std::min(earliest, m->prepare());
-    if (monotonic_ns() < earliest) {
-      detail::futex_wait(bell, rung, earliest == Worker::kNever ? -1 : earliest);
-      continue;  // mail, a spurious wake, or a release: the loop tells which
+    if (const std::int64_t now = monotonic_ns(); now < earliest) {
+      const std::int64_t lead = earliest == Worker::kNever ? 0 : wake_lead();
+      if (now < earliest - lead) {
+        detail::futex_wait(bell, rung, earliest == Worker::kNever ? -1 : earliest - lead);
+        continue;  // mail, a spurious wake, or the wake-up: the loop tells which
+      }
+      // Woken ahead of the release: spin to it, and to any mail posted meanwhile.
+      while (monotonic_ns() < earliest && bell.load(std::memory_order_relaxed) == rung) detail::cpu_relax();
+      continue;  // the bell's acquire is at the top of the loop
     }
     // The members' releases that have come, in data-flow order (the members' order), each member
     // caught up before the next: after a stall a producer runs its late releases (late: run) or
@@ -79,6 +86,19 @@ void TaskThread::run_periodic_members() {
       }
     }
   }
+}
+
+std::int64_t TaskThread::wake_lead() const noexcept {
+  for (const Worker* m : members) {
+    if (!m->task->periodic() || m->task->state() != TaskState::kOn) continue;
+    // Under edf and muf the thread wakes in the releasing band to have its job ranked: a spin
+    // there would hold off the ranking of every other job of its CPU.
+    if (m->dispatcher != nullptr) return 0;
+    const bool waits_on_another_cpu = std::ranges::any_of(
+        m->predecessors, [m](const Worker* p) { return p->cpu != m->cpu && p->task->state() == TaskState::kOn; });
+    return release_policy::wake_lead(waits_on_another_cpu, m->task->period_ns());
+  }
+  return 0;
 }
 
 }  // namespace chimera

@@ -88,5 +88,13 @@ TEST(ReleasePolicySameRate, TheWaitIsBoundedByHalfTheDeadlineFromWhenItStarts) {
   EXPECT_EQ(producer_wait_until(10 * kMs, 40 * kMs, kMs), 40 * kMs + 500'000);
 }
 
+TEST(ReleasePolicyWakeLead, OnlyAThreadWaitingOnAnotherCpuWakesEarlyAndNeverByMoreThanATwentiethOfItsPeriod) {
+  EXPECT_EQ(wake_lead(false, kMs), 0) << "nothing to wait for on another CPU: it would spin for nothing";
+  EXPECT_EQ(wake_lead(true, kMs), 50'000) << "1 kHz: the whole lead, 5 % of the period";
+  EXPECT_EQ(wake_lead(true, 10 * kMs), kMaxWakeLeadNs) << "a slower task spins no longer";
+  EXPECT_EQ(wake_lead(true, 200'000), 10'000) << "5 kHz: a twentieth of the period";
+  EXPECT_EQ(wake_lead(true, 0), 0) << "aperiodic";
+}
+
 }  // namespace
 }  // namespace chimera::release_policy
