@@ -67,6 +67,9 @@ KEYS = [
         "lost cycles of the PID over switches at 1 kHz between a generator in the main process and one in a module process"),
     Key("process_death_to_error_ns_p50", "ns", "a module process killed: to its task in ERROR and the flag up, p50"),
     Key("process_death_to_error_ns_max", "ns", "the same, worst"),
+    Key("process_death_seen_ns_p50", "ns",
+        "the same, to the look of an ordinary polling thread that found the flag up (its own scheduling added), p50"),
+    Key("process_death_seen_ns_max", "ns", "the same, worst"),
     Key("process_clear_to_on_ns_p50", "ns", "clear (the process started anew) then on: to the task ON, p50"),
     Key("process_clear_to_on_ns_max", "ns", "the same, worst"),
     Key("api_stream_latency_p99_ratio", "x",
@@ -203,6 +206,8 @@ GOALS = [
          lambda r: r["process_death_to_error_ns_max"] <= 1_000_000 if _have(r, "process_death_to_error_ns_max")
          else None,
          lambda r: (f"p50 {_fmt(r['process_death_to_error_ns_p50'])}, worst {_fmt(r['process_death_to_error_ns_max'])}"
+                    + (f" (a polling thread saw it: worst {_fmt(r['process_death_seen_ns_max'])})"
+                       if _have(r, "process_death_seen_ns_max") else "")
                     + (f"; clear to ON p50 {_fmt(r['process_clear_to_on_ns_p50'])}"
                        if _have(r, "process_clear_to_on_ns_p50") else ""))),
     Goal("a browser streaming 20 variables at 1 kHz costs the real-time tasks' release latency p99 at most 1.05x",
