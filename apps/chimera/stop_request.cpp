@@ -3,6 +3,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <csignal>
@@ -15,33 +16,39 @@ namespace chimera::cli {
 
 namespace {
 
-// Lock-free, so it may be touched from a signal handler; global, because a handler reaches nothing else.
+// The first stop request's time on CLOCK_MONOTONIC, 0 until one arrives: the flag and the time
+// in one atomic, because the stop signals may be handled on two threads at once (each handler
+// blocks the others only on its own thread), and a second handler that saw a flag without its
+// time would take a request repeated within the grace for one after it. Lock-free, so a handler
+// may touch it; global, because a handler reaches nothing else. A request repeated within kGrace
+// (timeout(1) signals the child and then its whole group; a service manager may do the same) is
+// the same request.
 // NOLINTNEXTLINE(cppcoreguidelines-avoid-non-const-global-variables): see above
-std::atomic<bool> g_stop{false};
-static_assert(std::atomic<bool>::is_always_lock_free);
-
-constexpr std::array kStopSignals{SIGINT, SIGTERM, SIGHUP};
-
-// The first stop request's time: a request repeated within kGrace (timeout(1) signals the
-// child and then its whole group; a service manager may do the same) is the same request.
-// NOLINTNEXTLINE(cppcoreguidelines-avoid-non-const-global-variables): see g_stop
 std::atomic<std::int64_t> g_first_ns{0};
 static_assert(std::atomic<std::int64_t>::is_always_lock_free);
 constexpr std::int64_t kGraceNs = 1'000'000'000;
 
+constexpr std::array kStopSignals{SIGINT, SIGTERM, SIGHUP};
+
 std::int64_t monotonic_now_ns() {
   timespec ts{};
   ::clock_gettime(CLOCK_MONOTONIC, &ts);  // async-signal-safe
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+  // Never 0 (the clock counts from boot), so 0 can mean "no request yet"; max() makes sure.
+  return std::max<std::int64_t>(1, static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec);
+}
+
+// Records the first request and returns 0, or returns the first one's time when there was one.
+std::int64_t note_request(std::int64_t now_ns) {
+  std::int64_t first_ns = 0;
+  // relaxed: the value carries no other data; the main loop only needs to see it eventually.
+  if (g_first_ns.compare_exchange_strong(first_ns, now_ns, std::memory_order_relaxed)) return 0;
+  return first_ns;
 }
 
 extern "C" void on_stop_signal(int signo) {
-  // relaxed: the flag carries no other data; the main loop only needs to see it eventually.
-  if (!g_stop.exchange(true, std::memory_order_relaxed)) {
-    g_first_ns.store(monotonic_now_ns(), std::memory_order_relaxed);  // read only by this handler
-    return;
-  }
-  if (monotonic_now_ns() - g_first_ns.load(std::memory_order_relaxed) < kGraceNs) return;
+  const std::int64_t now_ns = monotonic_now_ns();
+  const std::int64_t first_ns = note_request(now_ns);
+  if (first_ns == 0 || now_ns - first_ns < kGraceNs) return;
   // Asked again after the grace: the clean stop is stuck, or too slow for whoever asks. End the
   // default way, but first take the shared memory's name away: no sequence of signals leaves it.
   GlobalTable::remove_owned_names_now();
@@ -66,9 +73,10 @@ void install_stop_handlers() {
   std::signal(SIGPIPE, SIG_IGN);
 }
 
-bool stop_requested() { return g_stop.load(std::memory_order_relaxed); }
+// relaxed: as note_request's exchange; the loop only needs to see it eventually.
+bool stop_requested() { return g_first_ns.load(std::memory_order_relaxed) != 0; }
 
-// relaxed: as the handler's store; the loop only needs to see it eventually.
-void request_stop() { g_stop.store(true, std::memory_order_relaxed); }
+// A signal within the grace after it is the same request, as after a signal.
+void request_stop() { (void)note_request(monotonic_now_ns()); }
 
 }  // namespace chimera::cli

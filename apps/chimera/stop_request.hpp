@@ -11,7 +11,8 @@ namespace chimera::cli {
 void install_stop_handlers();
 /// Whether SIGINT, SIGTERM or SIGHUP has arrived, or request_stop() was called.
 bool stop_requested();
-/// Asks for the same clean stop as a signal (the network API's `quit`). Any thread.
+/// Asks for the same clean stop as a signal (the network API's `quit`); a signal within a
+/// second after it is the same request. Any thread.
 void request_stop();
 
 }  // namespace chimera::cli
