@@ -252,6 +252,11 @@ def cycle(doc, plots):
     if pid is not None:
         out.append(f"With the real `pid_joint` the same cycle costs {F(pid)}: the PID law itself is "
                    f"{F(max(pid - c, 0))}.")
+    other = _d(doc, "cycle_overhead", "cycle_overhead_inputs_from_other_cpu_ns")
+    if other is not None:
+        out.append(f"With the four inputs just written on the other CPU (a task whose producers run there), "
+                   f"each cycle timed alone: {F(other)}, two clock reads included; the difference is what "
+                   "reading from the other CPU's cache adds.")
     out.append("")
     return out
 

@@ -8,14 +8,21 @@
 // cycle with the flight recorder on (docs/flight-recorder.md): tau_r's value and the cycle's
 // timing record written into rings, as `chimera run` does by default; bench/run.py reports
 //   flight_recorder_cost_ns = BM_PidCycleRecorded - BM_PidCycleFramework.
+// BM_PidCycleInputsFromOtherCpu is the framework's cycle when the four inputs were just written
+// on the other CPU, as for a task whose producers run there (a module process's PID of
+// process_bench): each cycle alone is timed, after a thread pinned to the other CPU has written
+// them; bench/run.py reports it as cycle_overhead_inputs_from_other_cpu_ns.
 
 #include <unistd.h>
 
 #include <array>
+#include <atomic>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <benchmark/benchmark.h>
@@ -25,6 +32,7 @@
 #include "chimera/config/verify.hpp"
 #include "chimera/core/history_rings.hpp"
 #include "chimera/svt/global_table.hpp"
+#include "common/bench_util.hpp"
 #include "exec/task.hpp"
 
 namespace chimera::bench {
@@ -139,10 +147,47 @@ void BM_PidCycleRecorded(benchmark::State& state) {
   }
 }
 
+void BM_PidCycleInputsFromOtherCpu(benchmark::State& state) {
+  const unsigned cpus = std::thread::hardware_concurrency();
+  if (cpus < 2 || !pin_to_cpu(0)) {
+    state.SkipWithError("needs two CPUs and the right to pin to them");
+    return;
+  }
+  PidFixture f("bench_null_pid");
+  // The producer's turn and the consumer's, each on a line of its own, so that the handshake
+  // does not share a line with what is measured.
+  alignas(64) std::atomic<std::uint64_t> asked{0};
+  alignas(64) std::atomic<std::uint64_t> written{0};
+  std::jthread producer([&](const std::stop_token& stop) {
+    (void)pin_to_cpu(static_cast<int>(cpus - 1));
+    std::uint64_t turn = 0;
+    while (!stop.stop_requested()) {
+      if (asked.load(std::memory_order_acquire) == turn) continue;  // acquire: after the consumer's cycle
+      ++turn;
+      f.write_inputs();
+      written.store(turn, std::memory_order_release);  // release: the writes before the consumer's cycle
+    }
+  });
+  std::uint64_t turn = 0;
+  for (auto _ : state) {
+    asked.store(++turn, std::memory_order_release);            // release: the last cycle's reads are done
+    while (written.load(std::memory_order_acquire) != turn) {  // acquire: pairs with the producer
+    }
+    const auto begin = std::chrono::steady_clock::now();
+    f.cycle();
+    const auto end = std::chrono::steady_clock::now();
+    benchmark::ClobberMemory();
+    state.SetIterationTime(std::chrono::duration<double>(end - begin).count());
+  }
+  producer.request_stop();
+  producer.join();
+}
+
 BENCHMARK(BM_ProducerWrites);
 BENCHMARK(BM_PidCycleFramework);
 BENCHMARK(BM_PidCycleReal);
 BENCHMARK(BM_PidCycleRecorded);
+BENCHMARK(BM_PidCycleInputsFromOtherCpu)->UseManualTime();
 
 }  // namespace
 }  // namespace chimera::bench
