@@ -73,7 +73,8 @@ KEYS = [
     Key("process_clear_to_on_ns_p50", "ns", "clear (the process started anew) then on: to the task ON, p50"),
     Key("process_clear_to_on_ns_max", "ns", "the same, worst"),
     Key("api_stream_latency_p99_ratio", "x",
-        "Figure 4's tasks' release latency p99 with 10 clients streaming 20 variables at 1 kHz / without, worst task"),
+        "Figure 4's tasks' release latency p99 with 10 clients streaming 20 variables at 1 kHz / without, worst task "
+        "(the clients on the CPUs chimera leaves to ordinary work, as browsers on other machines)"),
     Key("api_stream_control_p99_ratio", "x",
         "the control of that ratio: the quiet windows of odd pairs / of even pairs, worst task (1.00: no error)"),
     Key("api_round_trip_ns_p50", "ns", "a command (get theta_m) over HTTP on loopback, request to reply, p50"),

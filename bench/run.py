@@ -221,11 +221,15 @@ def run_network_api(build, ctx):
     # latency histogram counted within each window (bench/windows.py says why windows).
     window_s, pairs = 2, (3 if ctx.quick else 15)
     run = ServedRun(chimera, yaml, pairs * 2 * (window_s + 2) + 10, ctx, "windows")
+    clients_cpus = run.ordinary_cpus()
     cmd = load + ["windows", run.base, run.token, "10", "1000", str(window_s), str(pairs), ",".join(variables),
                   str(ONIKA_BATCH_HZ), ",".join(fig4_tasks)]
     ctx.log(" ".join(cmd[:4] + ["URL", "TOKEN"] + cmd[6:10] + ["..."]))
     try:
-        out = subprocess.run(cmd, capture_output=True, text=True, timeout=pairs * 2 * (window_s + 10) + 60)
+        # The clients stand in for browsers on other machines: they run where the server's own
+        # ordinary threads do, off the CPU of Figure 4's tasks (docs/scheduling.md, "Ordinary threads").
+        out = subprocess.run(cmd, capture_output=True, text=True, timeout=pairs * 2 * (window_s + 10) + 60,
+                             **run.beside())
         if out.returncode != 0:
             raise RuntimeError(f"api_load windows: {out.stderr.strip()}")
         windows = json.loads(out.stdout)["windows"]
@@ -242,18 +246,19 @@ def run_network_api(build, ctx):
     # The command round trip, and the memory with 100 clients streaming (each a connection and a thread).
     run = ServedRun(chimera, yaml, 20, ctx, "round_trip")
     time.sleep(1)
-    out = subprocess.run(load + ["roundtrip", run.base, run.token, "2000"], capture_output=True, text=True, timeout=120)
+    out = subprocess.run(load + ["roundtrip", run.base, run.token, "2000"], capture_output=True, text=True, timeout=120,
+                         **run.beside())
     if out.returncode != 0:
         raise RuntimeError(f"api_load roundtrip: {out.stderr.strip()}")
     round_trip = json.loads(out.stdout)
     out = subprocess.run(load + ["roundtrip", run.base, run.token, "2000", "keepalive"], capture_output=True, text=True,
-                         timeout=120)
+                         timeout=120, **run.beside())
     if out.returncode != 0:
         raise RuntimeError(f"api_load roundtrip keepalive: {out.stderr.strip()}")
     kept_alive = json.loads(out.stdout)
     rss_idle = run.rss_kb()
     hold = subprocess.Popen(load + ["stream", run.base, run.token, "100", "10", "6", "theta_m"], stdout=subprocess.PIPE,
-                            text=True)
+                            text=True, **run.beside())
     time.sleep(6)
     rss_held = run.rss_kb()
     held = json.loads(hold.communicate(timeout=60)[0])
@@ -277,6 +282,7 @@ def run_network_api(build, ctx):
                "api_round_trip_keepalive_ns_p99": kept_alive["p99_ns"],
                "api_memory_100_clients_kb": rss_held}
     details = {"window_s": window_s, "pairs": pairs, "variables": variables, "batch_hz": ONIKA_BATCH_HZ,
+               "clients_cpus": sorted(clients_cpus),
                "samples_per_client_per_s": delivered, "samples_per_client_per_s_least_window": least,
                "p99_ns_without_clients": none, "p99_ns_with_clients": with_clients, "ratios": ratios,
                "control_ratios": compared["control_ratios"], "cycles_and_missed": compared["cycles_and_missed"],

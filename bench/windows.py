@@ -45,6 +45,17 @@ class ServedRun:
             self.proc.kill()
             raise RuntimeError(f"chimera printed no link: see {self.err.name}")
 
+    def ordinary_cpus(self):
+        """The CPUs chimera keeps its ordinary threads on (its main thread's, after start): those no
+        real-time task of it runs on, or every usable one when each has one."""
+        return os.sched_getaffinity(self.proc.pid)
+
+    def beside(self):
+        """For subprocess: a client of this run started on its ordinary CPUs, as a browser on
+        another machine stands apart from its real-time tasks."""
+        cpus = self.ordinary_cpus()
+        return {"preexec_fn": lambda: os.sched_setaffinity(0, cpus)}
+
     def rss_kb(self):
         try:
             m = re.search(r"^VmRSS:\s+(\d+) kB", Path(f"/proc/{self.proc.pid}/status").read_text(), re.M)

@@ -30,6 +30,7 @@
 #include "line_reader.hpp"
 #include "load_file.hpp"
 #include "network.hpp"
+#include "ordinary_cpus.hpp"
 #include "rt_check_allocator.hpp"
 #include "stop_request.hpp"
 
@@ -223,6 +224,14 @@ int run_command(const RunArgs& args) {
     return kExitInvalid;
   }
 
+  // The ordinary threads, these and the ones started below, off the real-time tasks' CPUs where
+  // there is a CPU without any (ordinary_cpus.hpp says why).
+  if (args.clock == ClockKind::kReal) {
+    std::vector<int> realtime_cpus;
+    for (const auto& task : subsystem.snapshot()) realtime_cpus.push_back(task.cpu);
+    (void)keep_ordinary_threads_on(ordinary_cpus(realtime_cpus));
+  }
+
   // The resource ports to other subsystems: on their own ordinary threads, attached to the table;
   // idle until a file with exports or imports runs (this one, or one opened later).
   std::unique_ptr<DdsBridge> remote;
@@ -255,7 +264,7 @@ int run_command(const RunArgs& args) {
   }
   Session session(subsystem, gate, remote.get(), args, interactive);
   session.run();
-  network.reset();  // the network API ends before the subsystem stops
+  network.reset();                      // the network API ends before the subsystem stops
   subsystem.report_remote_imports({});  // no command runs any more: the bridge can go
   if (remote) {
     for (const auto& line : remote->stop()) err("dds: " + line + "\n");  // it writes no import after this

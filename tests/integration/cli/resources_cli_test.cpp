@@ -1,11 +1,13 @@
 // `chimera run` against the machine's resources, each the real thing: a /dev/shm with no room
 // left (a small tmpfs mounted over it in a mount namespace of the test's own), a log on /dev/full
 // and on a disk that fills during the run, shared memory left by a run killed with SIGKILL
-// (its pid dead, or its pid now a live unrelated process's), two live runs of one name, and
-// every sequence of SIGINT, SIGTERM and SIGHUP sent to a running process; `chimera analyze`'s
-// measuring runs stopped by a signal or killed outright.
+// (its pid dead, or its pid now a live unrelated process's), two live runs of one name, every
+// sequence of SIGINT, SIGTERM and SIGHUP sent to a running process, and the CPUs its ordinary
+// threads may use beside its real-time ones; `chimera analyze`'s measuring runs stopped by a
+// signal or killed outright.
 
 #include <fcntl.h>
+#include <sched.h>
 #include <signal.h>
 #include <sys/mman.h>
 #include <sys/wait.h>
@@ -19,6 +21,7 @@
 #include <cstring>
 #include <filesystem>
 #include <string>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -375,6 +378,77 @@ TEST_F(ResourcesCliTest, NoSequenceOfStopSignalsLeavesTheRegionBehind) {
       EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << said << status << "\n" << run.output();
       EXPECT_TRUE(contains(run.output(), "latency p99")) << said << run.output();
     }
+}
+
+// A thread of a running process: its name, its scheduling policy and the CPUs it may run on.
+struct ThreadPlace {
+  std::string name;
+  int policy = -1;
+  std::vector<int> cpus;
+};
+
+std::vector<int> cpus_of(const cpu_set_t& set) {
+  std::vector<int> cpus;
+  for (int cpu = 0; cpu < CPU_SETSIZE; ++cpu)
+    if (CPU_ISSET(cpu, &set)) cpus.push_back(cpu);
+  return cpus;
+}
+
+std::vector<ThreadPlace> threads_of(pid_t pid) {
+  std::vector<ThreadPlace> out;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator("/proc/" + std::to_string(pid) + "/task", ec)) {
+    const auto tid = static_cast<pid_t>(std::stol(entry.path().filename().string()));
+    cpu_set_t set;
+    CPU_ZERO(&set);
+    if (::sched_getaffinity(tid, sizeof(set), &set) != 0) continue;  // ended meanwhile
+    std::string name = read_text(entry.path().string() + "/comm");
+    if (!name.empty() && name.back() == '\n') name.pop_back();
+    out.push_back({name, ::sched_getscheduler(tid), cpus_of(set)});
+  }
+  return out;
+}
+
+// The ordinary threads (the network API's among them, started after the tasks) keep off the CPUs
+// of the real-time tasks where a CPU has none: on this kernel a thread inside a system call is not
+// preempted, so a task released meanwhile would wait for it. Where every CPU has a task, or
+// SCHED_FIFO is refused, they keep every CPU the process may use.
+TEST_F(ResourcesCliTest, OrdinaryThreadsKeepOffTheCpusOfTheRealTimeTasks) {
+  const std::string n = tracked(name("ordinary"));
+  RunningChimera run(dir_, {"run", file(n), "--listen", "127.0.0.1:0"});
+  ASSERT_TRUE(wait_for_region(n)) << run.output();
+  std::vector<ThreadPlace> threads;
+  for (int i = 0; i < 1000; ++i) {  // the server's threads start after the region appears
+    threads = threads_of(run.pid());
+    if (std::any_of(threads.begin(), threads.end(), [](const auto& t) { return t.name == "civetweb-master"; })) break;
+    std::this_thread::sleep_for(10ms);
+  }
+  ASSERT_TRUE(std::any_of(threads.begin(), threads.end(), [](const auto& t) { return t.name == "civetweb-master"; }))
+      << run.output();
+  cpu_set_t usable_set;
+  CPU_ZERO(&usable_set);
+  ASSERT_EQ(::sched_getaffinity(0, sizeof(usable_set), &usable_set), 0);
+  const std::vector<int> usable = cpus_of(usable_set);
+  std::vector<int> realtime;  // the CPUs the real-time threads are pinned to
+  for (const auto& t : threads)
+    if (t.policy == SCHED_FIFO) {
+      EXPECT_EQ(t.cpus.size(), 1U) << t.name << ": a real-time thread is pinned to its CPU";
+      realtime.insert(realtime.end(), t.cpus.begin(), t.cpus.end());
+    }
+  std::vector<int> expected;
+  for (const int cpu : usable)
+    if (std::find(realtime.begin(), realtime.end(), cpu) == realtime.end()) expected.push_back(cpu);
+  if (realtime.empty() || expected.empty()) expected = usable;
+  int ordinary = 0;
+  for (const auto& t : threads)
+    if (t.policy != SCHED_FIFO) {
+      ++ordinary;
+      EXPECT_EQ(t.cpus, expected) << t.name << " (" << realtime.size() << " real-time threads)";
+    }
+  EXPECT_GT(ordinary, 3) << "the main thread, the service thread and the server's";
+  run.signal(SIGTERM);
+  const int status = run.wait(30s);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << status << "\n" << run.output();
 }
 
 // A file whose measuring runs take seconds: 200 tasks at 100 us, two million releases a run.
